@@ -1,0 +1,48 @@
+"""halsdk: a Python SDK of the LinuxCNC-style Hardware Abstraction Layer.
+
+Typical use::
+
+    import halsdk
+
+    with halsdk.Hal() as hal:
+        hal.newthread("servo", 1_000_000)
+        hal.loadrt("mycomp")
+        hal.addf("mycomp.0", "servo")
+        hal.net("cmd", "mycomp.0.out", "other.0.in")
+        hal.step(1000)            # deterministic, simulated time
+"""
+
+from halsdk import _core
+from halsdk.component import Component, component
+from halsdk.errors import (CapacityError, ConflictError, ExistsError,
+                           HalError, HalTypeError, InstanceError, InvalidError,
+                           LoadError, NotFoundError, NotPermittedError,
+                           StaleError)
+from halsdk.hal import Hal
+from halsdk.instance import cleanup
+from halsdk.types import Direction, HalType
+
+Pin = _core.Pin
+Param = _core.Param
+Signal = _core.Signal
+Function = _core.Function
+Thread = _core.Thread
+
+BIT, FLOAT, S32, U32, S64, U64 = (HalType.BIT, HalType.FLOAT, HalType.S32,
+                                  HalType.U32, HalType.S64, HalType.U64)
+IN, OUT, IO, RO, RW = (Direction.IN, Direction.OUT, Direction.IO,
+                       Direction.RO, Direction.RW)
+NAME_LEN = _core.NAME_LEN
+REFERENCE_NAME_LEN = 47
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "Hal", "component", "Component", "cleanup", "HalType", "Direction",
+    "Pin", "Param", "Signal", "Function", "Thread",
+    "BIT", "FLOAT", "S32", "U32", "S64", "U64", "IN", "OUT", "IO", "RO",
+    "RW", "NAME_LEN", "REFERENCE_NAME_LEN",
+    "HalError", "NotFoundError", "ExistsError", "HalTypeError",
+    "ConflictError", "NotPermittedError", "InvalidError", "CapacityError",
+    "InstanceError", "StaleError", "LoadError",
+]

@@ -1,0 +1,1122 @@
+# cython: language_level=3, boundscheck=False, wraparound=False
+"""Low-level binding of the halsdk core (C).
+
+This module maps the instance, exposes the object records as Python
+handles and publishes the C API table as a capsule for compiled
+components.  The public Python API is :mod:`halsdk` (``halsdk.Hal``);
+this module is its engine and is not meant to be used directly.
+"""
+
+from libc.stdint cimport int16_t, int32_t, int64_t, uint8_t, uint16_t, \
+    uint32_t, uint64_t
+from libc.string cimport memset
+from cpython.pycapsule cimport PyCapsule_New
+from cpython.ref cimport PyObject, Py_INCREF, Py_DECREF
+
+import os
+import sys
+import traceback
+
+from halsdk import errors as _errors
+
+cdef extern from "hal_core.h" nogil:
+    ctypedef uint32_t hoff_t
+    ctypedef union hal_value_t:
+        uint8_t b
+        int32_t s
+        uint32_t u
+        double f
+        int64_t ls
+        uint64_t lu
+
+    enum:
+        K_NONE, K_COMP, K_INST, K_PIN, K_PARAM, K_SIG, K_FUNCT, K_THREAD,
+        K_NKINDS
+        HALSDK_BIT, HALSDK_FLOAT, HALSDK_S32, HALSDK_U32, HALSDK_S64,
+        HALSDK_U64, HALSDK_IN, HALSDK_OUT, HALSDK_IO, HALSDK_RO, HALSDK_RW
+        HALSDK_COMP_USER, HALSDK_COMP_RT, HALSDK_NAME_LEN
+        HAL_LOCK_PARAMS, HAL_DEFAULT_SIZE, HAL_ABI_VERSION
+
+    ctypedef struct hal_obj_t:
+        hoff_t next, prev
+        uint16_t kind
+        uint32_t gen
+        char name[128]
+
+    ctypedef struct hal_comp_t:
+        hal_obj_t o
+        int32_t id
+        int32_t kind
+        int32_t ready
+        int32_t pid
+        uint64_t pid_start
+        int32_t ninst
+
+    ctypedef struct hal_inst_t:
+        hal_obj_t o
+        int32_t id
+        hoff_t comp
+
+    ctypedef struct hal_pin_t:
+        hal_obj_t o
+        hoff_t comp, inst, ptr_cell, signal, oldname
+        int16_t type, dir
+        hal_value_t dummy
+
+    ctypedef struct hal_param_t:
+        hal_obj_t o
+        hoff_t comp, inst, data, oldname
+        int16_t type, dir
+
+    ctypedef struct hal_sig_t:
+        hal_obj_t o
+        int16_t type
+        int32_t readers, writers, bidirs
+        hal_value_t value
+
+    ctypedef struct hal_funct_t:
+        hal_obj_t o
+        hoff_t comp, inst
+        int32_t uses_fp, reentrant, users, python
+        hoff_t time_pin, tmax_param, tmax_inc_param
+
+    ctypedef struct hal_fentry_t:
+        hoff_t next
+        hoff_t funct
+
+    ctypedef struct hal_thread_t:
+        hal_obj_t o
+        int64_t period
+        int32_t uses_fp, priority, running, slot
+        uint32_t timing_every
+        hoff_t comp, functs, time_pin, tmax_param
+        int32_t nfuncts
+        uint64_t cycles, overruns
+
+    ctypedef struct hal_header_t:
+        uint32_t abi
+        uint64_t size
+        char instance[64]
+        int32_t host_pid
+        uint64_t host_start
+        uint32_t serial
+        uint32_t lock
+        int32_t msg_level
+        hoff_t heap_start, heap_top, heap_end
+        uint64_t bytes_used
+        hoff_t list_head[8]
+        int32_t count[8]
+        int32_t sim_clock
+        int64_t sim_time
+        int32_t threads_running
+        int32_t recovered
+
+    ctypedef struct hal_map_t:
+        char *base
+        hal_header_t *hdr
+        long size
+        int is_host
+
+    hal_map_t hal_map
+    int hal_loading_rt
+    ctypedef void (*halsdk_funct_t)(void *, long)
+    ctypedef struct halsdk_api:
+        int version
+    const halsdk_api halsdk_api_table
+
+    const char *hal_last_error()
+    int hal_fail(int err, const char *fmt, ...)
+    int hal_instance_create(const char *shm, const char *inst, long size)
+    int hal_instance_attach(const char *shm)
+    void hal_instance_detach(int unlink_shm, const char *shm)
+    int hal_instance_probe(const char *shm, int *pid, uint64_t *start,
+                           int *abi)
+    uint64_t hal_proc_start_time(int pid)
+    int hal_pid_alive(int pid, uint64_t start)
+    int hal_lock()
+    void hal_unlock()
+    int hal_hold_lock_for_test(double seconds)
+    void *hal_find(int kind, const char *name)
+    hal_comp_t *hal_comp_by_id(int id)
+    int hal_check_name(const char *name, const char *what)
+    int hal_comp_new(const char *name, int kind)
+    int hal_comp_exit(int id)
+    int hal_comp_set_ready(int id, int ready)
+    int hal_inst_new(const char *name, int comp_id)
+    int hal_inst_delete(const char *name)
+    void *hal_malloc_owned(long size, int owner_id)
+    int hal_pin_new(const char *name, int type, int dir, void **cell,
+                    int owner_id)
+    int hal_param_new(const char *name, int type, int dir, void *data,
+                      int owner_id)
+    int hal_alias(int kind, const char *name, const char *alias)
+    int hal_unalias(int kind, const char *alias)
+    int hal_signal_new(const char *name, int type)
+    int hal_signal_delete(const char *name)
+    int hal_link(const char *pin, const char *sig)
+    int hal_unlink(const char *pin)
+    int hal_export_funct(const char *name, halsdk_funct_t fn, void *arg,
+                         int uses_fp, int reentrant, int owner_id,
+                         int python)
+    int hal_thread_new(const char *name, long period, int uses_fp,
+                       unsigned every)
+    int hal_thread_delete(const char *name)
+    int hal_addf(const char *f, const char *t, int pos)
+    int hal_delf(const char *f, const char *t)
+    int hal_stop_threads()
+    int exec_start_all(int want_rt, char *note, int notelen)
+    int exec_run_cycles(int slot, long n)
+    int exec_step_all(long n)
+    int hal_set_lock(unsigned char lock)
+    int hal_check_consistency(char *rep, int len)
+    hal_value_t *hal_pin_value(hal_pin_t *pin)
+    void *hal_param_value(hal_param_t *param)
+    long long hal_get_time()
+
+cdef inline void *SHMPTR(hoff_t off) noexcept nogil:
+    return <void *>(hal_map.base + off)
+
+cdef inline hoff_t SHMOFF(void *p) noexcept nogil:
+    return <hoff_t>(<char *>p - hal_map.base)
+
+BIT = HALSDK_BIT
+FLOAT = HALSDK_FLOAT
+S32 = HALSDK_S32
+U32 = HALSDK_U32
+S64 = HALSDK_S64
+U64 = HALSDK_U64
+IN = HALSDK_IN
+OUT = HALSDK_OUT
+IO = HALSDK_IO
+RO = HALSDK_RO
+RW = HALSDK_RW
+COMP_USER = HALSDK_COMP_USER
+COMP_RT = HALSDK_COMP_RT
+NAME_LEN = HALSDK_NAME_LEN
+DEFAULT_SIZE = HAL_DEFAULT_SIZE
+ABI_VERSION = HAL_ABI_VERSION
+
+TYPE_NAMES = {BIT: "bit", FLOAT: "float", S32: "s32", U32: "u32",
+              S64: "s64", U64: "u64"}
+DIR_NAMES = {IN: "IN", OUT: "OUT", IO: "I/O", RO: "RO", RW: "RW"}
+
+_C_API = PyCapsule_New(<void *>&halsdk_api_table,
+                       b"halsdk._core._C_API", NULL)
+
+_ERRNO_CLASS = {
+    2: _errors.NotFoundError,        # ENOENT
+    17: _errors.ExistsError,         # EEXIST
+    91: _errors.HalTypeError,        # EPROTOTYPE
+    16: _errors.ConflictError,       # EBUSY
+    1: _errors.NotPermittedError,    # EPERM
+    12: _errors.CapacityError,       # ENOMEM
+    28: _errors.CapacityError,       # ENOSPC
+    22: _errors.InvalidError,        # EINVAL
+    71: _errors.InstanceError,       # EPROTO
+    19: _errors.InstanceError,       # ENODEV
+}
+
+
+cdef int check(int r) except -1:
+    """Raise the exception of a negative core return."""
+    if r >= 0:
+        return r
+    msg = hal_last_error().decode("utf-8", "replace")
+    raise _ERRNO_CLASS.get(-r, _errors.HalError)(msg)
+
+
+cdef bytes enc(name):
+    if not isinstance(name, str):
+        raise _errors.InvalidError(
+            f"HAL names are strings, not {type(name).__name__}: {name!r}")
+    b = name.encode("utf-8")
+    if b"\0" in b:
+        raise _errors.InvalidError(f"name {name!r} contains a NUL byte")
+    return b
+
+
+cdef int need_instance() except -1:
+    if hal_map.hdr == NULL:
+        raise _errors.InstanceError("no HAL instance is attached "
+                                    "in this process")
+    return 0
+
+
+# ---------------------------------------------------------------- values
+
+cdef object get_raw(int type, void *p):
+    if type == HALSDK_BIT:
+        return (<uint8_t *>p)[0] != 0
+    if type == HALSDK_FLOAT:
+        return (<double *>p)[0]
+    if type == HALSDK_S32:
+        return (<int32_t *>p)[0]
+    if type == HALSDK_U32:
+        return (<uint32_t *>p)[0]
+    if type == HALSDK_S64:
+        return (<int64_t *>p)[0]
+    return (<uint64_t *>p)[0]
+
+
+_INT_RANGE = {
+    HALSDK_S32: (-(1 << 31), (1 << 31) - 1),
+    HALSDK_U32: (0, (1 << 32) - 1),
+    HALSDK_S64: (-(1 << 63), (1 << 63) - 1),
+    HALSDK_U64: (0, (1 << 64) - 1),
+}
+
+
+def parse_value(int type, value, str what):
+    """Convert a Python value or a halcmd-style string for a HAL type."""
+    tname = TYPE_NAMES.get(type, "?")
+    if type == HALSDK_BIT:
+        if isinstance(value, str):
+            s = value.strip()
+            if s in ("1", "TRUE", "true", "True"):
+                return True
+            if s in ("0", "FALSE", "false", "False"):
+                return False
+        elif isinstance(value, (bool, int)) and value in (0, 1):
+            return bool(value)
+        elif hasattr(value, "__index__") and int(value) in (0, 1):
+            return bool(int(value))
+        raise _errors.InvalidError(
+            f"value '{value}' for {what} is not a bit (0, 1, TRUE or FALSE)")
+    if type == HALSDK_FLOAT:
+        try:
+            if isinstance(value, bool):
+                return float(value)
+            return float(value.strip() if isinstance(value, str) else value)
+        except (TypeError, ValueError):
+            raise _errors.InvalidError(
+                f"value '{value}' for {what} is not a float") from None
+    try:
+        if isinstance(value, str):
+            v = int(value.strip(), 0)
+        elif isinstance(value, float):
+            if not value.is_integer():
+                raise ValueError
+            v = int(value)
+        else:
+            v = int(value.__index__())
+    except (TypeError, ValueError, AttributeError):
+        raise _errors.InvalidError(
+            f"value '{value}' for {what} is not an integer") from None
+    lo, hi = _INT_RANGE[type]
+    if not lo <= v <= hi:
+        raise _errors.InvalidError(
+            f"value {v} for {what} is out of range for {tname} "
+            f"({lo} .. {hi})")
+    return v
+
+
+cdef int put_raw(int type, void *p, object v) except -1:
+    if type == HALSDK_BIT:
+        (<uint8_t *>p)[0] = 1 if v else 0
+    elif type == HALSDK_FLOAT:
+        (<double *>p)[0] = v
+    elif type == HALSDK_S32:
+        (<int32_t *>p)[0] = v
+    elif type == HALSDK_U32:
+        (<uint32_t *>p)[0] = v
+    elif type == HALSDK_S64:
+        (<int64_t *>p)[0] = v
+    else:
+        (<uint64_t *>p)[0] = v
+    return 0
+
+
+# ---------------------------------------------------------------- handles
+
+cdef class Item:
+    """A handle on a named object of the instance.
+
+    Handles stay valid while their object exists; using one after the
+    object was deleted raises :class:`halsdk.StaleError`.
+    """
+    cdef readonly int kind
+    cdef hoff_t off
+    cdef uint32_t gen
+    cdef str _name
+
+    cdef void *rec(self) except NULL:
+        need_instance()
+        cdef hal_obj_t *o = <hal_obj_t *>SHMPTR(self.off)
+        if o.kind != self.kind or o.gen != self.gen:
+            raise _errors.StaleError(
+                f"{KIND_WORDS[self.kind]} '{self._name}' no longer exists")
+        return o
+
+    @property
+    def name(self) -> str:
+        cdef hal_obj_t *o = <hal_obj_t *>self.rec()
+        return o.name.decode("utf-8", "replace")
+
+    @property
+    def exists(self) -> bool:
+        """False once the object has been deleted."""
+        if hal_map.hdr == NULL:
+            return False
+        cdef hal_obj_t *o = <hal_obj_t *>SHMPTR(self.off)
+        return o.kind == self.kind and o.gen == self.gen
+
+    def __eq__(self, other):
+        return (isinstance(other, Item) and (<Item>other).off == self.off
+                and (<Item>other).gen == self.gen)
+
+    def __hash__(self):
+        return hash((self.off, self.gen))
+
+    def __repr__(self):
+        return f"<{type(self).__name__} {self._name!r}>"
+
+
+KIND_WORDS = {K_COMP: "component", K_INST: "instance", K_PIN: "pin",
+              K_PARAM: "param", K_SIG: "signal", K_FUNCT: "function",
+              K_THREAD: "thread"}
+
+
+cdef Item make(int kind, void *p):
+    cdef Item it
+    cls = _KIND_CLASS[kind]
+    it = cls.__new__(cls)
+    it.kind = kind
+    it.off = SHMOFF(p)
+    it.gen = (<hal_obj_t *>p).gen
+    it._name = (<hal_obj_t *>p).name.decode("utf-8", "replace")
+    return it
+
+
+cdef str comp_name(hoff_t off):
+    return (<hal_obj_t *>SHMPTR(off)).name.decode("utf-8", "replace")
+
+
+cdef class Pin(Item):
+    """A pin: a typed endpoint of a component."""
+
+    @property
+    def type(self) -> int:
+        return (<hal_pin_t *>self.rec()).type
+
+    @property
+    def direction(self) -> int:
+        return (<hal_pin_t *>self.rec()).dir
+
+    @property
+    def owner(self) -> str:
+        return comp_name((<hal_pin_t *>self.rec()).comp)
+
+    @property
+    def owner_id(self) -> int:
+        return (<hal_comp_t *>SHMPTR((<hal_pin_t *>self.rec()).comp)).id
+
+    @property
+    def signal(self):
+        """The signal this pin is linked to, or None."""
+        cdef hal_pin_t *p = <hal_pin_t *>self.rec()
+        if p.signal == 0:
+            return None
+        return make(K_SIG, SHMPTR(p.signal))
+
+    @property
+    def linked(self) -> bool:
+        return (<hal_pin_t *>self.rec()).signal != 0
+
+    @property
+    def alias_of(self):
+        """The original name while the pin has an alias, else None."""
+        cdef hal_pin_t *p = <hal_pin_t *>self.rec()
+        if p.oldname == 0:
+            return None
+        return (<char *>SHMPTR(p.oldname)).decode("utf-8", "replace")
+
+    @property
+    def value(self):
+        cdef hal_pin_t *p = <hal_pin_t *>self.rec()
+        return get_raw(p.type, hal_pin_value(p))
+
+    @value.setter
+    def value(self, v):
+        self.setp(v)
+
+    def setp(self, v):
+        """Set the pin as ``halcmd setp`` does: an unlinked in or io pin."""
+        cdef hal_pin_t *p = <hal_pin_t *>self.rec()
+        if hal_map.hdr.lock & HAL_LOCK_PARAMS:
+            raise _errors.NotPermittedError(
+                f"cannot set pin '{self._name}': HAL is locked against "
+                "setting values")
+        if p.dir == HALSDK_OUT:
+            raise _errors.NotPermittedError(
+                f"pin '{self._name}' is not writable")
+        if p.signal != 0:
+            raise _errors.ConflictError(
+                f"pin '{self._name}' is connected to a signal")
+        v = parse_value(p.type, v, f"pin '{self._name}'")
+        put_raw(p.type, hal_pin_value(p), v)
+
+    def write(self, v):
+        """Write the value as the owning component does (any direction)."""
+        cdef hal_pin_t *p = <hal_pin_t *>self.rec()
+        v = parse_value(p.type, v, f"pin '{self._name}'")
+        put_raw(p.type, hal_pin_value(p), v)
+
+
+cdef class Param(Item):
+    """A parameter of a component."""
+
+    @property
+    def type(self) -> int:
+        return (<hal_param_t *>self.rec()).type
+
+    @property
+    def direction(self) -> int:
+        return (<hal_param_t *>self.rec()).dir
+
+    @property
+    def owner(self) -> str:
+        return comp_name((<hal_param_t *>self.rec()).comp)
+
+    @property
+    def owner_id(self) -> int:
+        return (<hal_comp_t *>SHMPTR((<hal_param_t *>self.rec()).comp)).id
+
+    @property
+    def alias_of(self):
+        cdef hal_param_t *p = <hal_param_t *>self.rec()
+        if p.oldname == 0:
+            return None
+        return (<char *>SHMPTR(p.oldname)).decode("utf-8", "replace")
+
+    @property
+    def value(self):
+        cdef hal_param_t *p = <hal_param_t *>self.rec()
+        return get_raw(p.type, hal_param_value(p))
+
+    @value.setter
+    def value(self, v):
+        self.setp(v)
+
+    def setp(self, v):
+        """Set the param as ``halcmd setp`` does: RW params only."""
+        cdef hal_param_t *p = <hal_param_t *>self.rec()
+        if hal_map.hdr.lock & HAL_LOCK_PARAMS:
+            raise _errors.NotPermittedError(
+                f"cannot set param '{self._name}': HAL is locked against "
+                "setting values")
+        if p.dir == HALSDK_RO:
+            raise _errors.NotPermittedError(
+                f"param '{self._name}' is not writable")
+        v = parse_value(p.type, v, f"param '{self._name}'")
+        put_raw(p.type, hal_param_value(p), v)
+
+    def write(self, v):
+        """Write the value as the owning component does (RO too)."""
+        cdef hal_param_t *p = <hal_param_t *>self.rec()
+        v = parse_value(p.type, v, f"param '{self._name}'")
+        put_raw(p.type, hal_param_value(p), v)
+
+
+cdef class Signal(Item):
+    """A signal: a typed wire between pins."""
+
+    @property
+    def type(self) -> int:
+        return (<hal_sig_t *>self.rec()).type
+
+    @property
+    def value(self):
+        cdef hal_sig_t *s = <hal_sig_t *>self.rec()
+        return get_raw(s.type, &s.value)
+
+    @value.setter
+    def value(self, v):
+        self.sets(v)
+
+    def sets(self, v):
+        """Set the signal as ``halcmd sets`` does: only without a writer."""
+        cdef hal_sig_t *s = <hal_sig_t *>self.rec()
+        if hal_map.hdr.lock & HAL_LOCK_PARAMS:
+            raise _errors.NotPermittedError(
+                f"cannot set signal '{self._name}': HAL is locked against "
+                "setting values")
+        if s.writers > 0:
+            raise _errors.ConflictError(
+                f"signal '{self._name}' already has writer(s)")
+        v = parse_value(s.type, v, f"signal '{self._name}'")
+        put_raw(s.type, &s.value, v)
+
+    @property
+    def writers(self) -> int:
+        return (<hal_sig_t *>self.rec()).writers
+
+    @property
+    def readers(self) -> int:
+        return (<hal_sig_t *>self.rec()).readers
+
+    @property
+    def bidirs(self) -> int:
+        return (<hal_sig_t *>self.rec()).bidirs
+
+    @property
+    def pins(self) -> list:
+        """The pins linked to this signal, in creation order."""
+        cdef hal_sig_t *s = <hal_sig_t *>self.rec()
+        cdef hoff_t so = SHMOFF(s)
+        cdef hoff_t o
+        cdef hal_pin_t *p
+        out = []
+        hal_lock()
+        try:
+            o = hal_map.hdr.list_head[K_PIN]
+            while o:
+                p = <hal_pin_t *>SHMPTR(o)
+                if p.signal == so:
+                    out.append(make(K_PIN, p))
+                o = p.o.next
+        finally:
+            hal_unlock()
+        return out
+
+
+cdef class Component(Item):
+    """A component: the owner of pins, params and functions."""
+
+    @property
+    def id(self) -> int:
+        return (<hal_comp_t *>self.rec()).id
+
+    @property
+    def realtime(self) -> bool:
+        return (<hal_comp_t *>self.rec()).kind == HALSDK_COMP_RT
+
+    @property
+    def ready(self) -> bool:
+        return (<hal_comp_t *>self.rec()).ready != 0
+
+    @property
+    def pid(self) -> int:
+        return (<hal_comp_t *>self.rec()).pid
+
+    @property
+    def alive(self) -> bool:
+        """False when the process that owns the component is gone."""
+        cdef hal_comp_t *c = <hal_comp_t *>self.rec()
+        return hal_pid_alive(c.pid, c.pid_start) != 0
+
+
+cdef class Instance(Item):
+    """An instance added to a component at run time (newinst)."""
+
+    @property
+    def id(self) -> int:
+        return (<hal_inst_t *>self.rec()).id
+
+    @property
+    def owner(self) -> str:
+        return comp_name((<hal_inst_t *>self.rec()).comp)
+
+
+cdef class Function(Item):
+    """A function exported by a realtime component."""
+
+    @property
+    def owner(self) -> str:
+        return comp_name((<hal_funct_t *>self.rec()).comp)
+
+    @property
+    def owner_id(self) -> int:
+        return (<hal_comp_t *>SHMPTR((<hal_funct_t *>self.rec()).comp)).id
+
+    @property
+    def uses_fp(self) -> bool:
+        return (<hal_funct_t *>self.rec()).uses_fp != 0
+
+    @property
+    def reentrant(self) -> bool:
+        return (<hal_funct_t *>self.rec()).reentrant != 0
+
+    @property
+    def users(self) -> int:
+        return (<hal_funct_t *>self.rec()).users
+
+    @property
+    def realtime(self) -> bool:
+        """False for a Python function: it takes the GIL."""
+        return (<hal_funct_t *>self.rec()).python == 0
+
+    @property
+    def time(self) -> int:
+        cdef hal_funct_t *f = <hal_funct_t *>self.rec()
+        return hal_pin_value(<hal_pin_t *>SHMPTR(f.time_pin)).s
+
+    @property
+    def tmax(self) -> int:
+        cdef hal_funct_t *f = <hal_funct_t *>self.rec()
+        return (<int32_t *>hal_param_value(
+            <hal_param_t *>SHMPTR(f.tmax_param)))[0]
+
+
+cdef class Thread(Item):
+    """A realtime thread and the functions it calls."""
+
+    @property
+    def period(self) -> int:
+        return (<hal_thread_t *>self.rec()).period
+
+    @property
+    def uses_fp(self) -> bool:
+        return (<hal_thread_t *>self.rec()).uses_fp != 0
+
+    @property
+    def running(self) -> bool:
+        return (<hal_thread_t *>self.rec()).running != 0
+
+    @property
+    def timing_every(self) -> int:
+        return (<hal_thread_t *>self.rec()).timing_every
+
+    @property
+    def cycles(self) -> int:
+        return (<hal_thread_t *>self.rec()).cycles
+
+    @property
+    def overruns(self) -> int:
+        return (<hal_thread_t *>self.rec()).overruns
+
+    @property
+    def time(self) -> int:
+        cdef hal_thread_t *t = <hal_thread_t *>self.rec()
+        return hal_pin_value(<hal_pin_t *>SHMPTR(t.time_pin)).s
+
+    @property
+    def tmax(self) -> int:
+        cdef hal_thread_t *t = <hal_thread_t *>self.rec()
+        return (<int32_t *>hal_param_value(
+            <hal_param_t *>SHMPTR(t.tmax_param)))[0]
+
+    @property
+    def functions(self) -> list:
+        """Names of the functions in call order."""
+        cdef hal_thread_t *t = <hal_thread_t *>self.rec()
+        cdef hoff_t e
+        out = []
+        hal_lock()
+        try:
+            e = t.functs
+            while e:
+                out.append((<hal_obj_t *>SHMPTR(
+                    (<hal_fentry_t *>SHMPTR(e)).funct)).name.decode())
+                e = (<hal_fentry_t *>SHMPTR(e)).next
+        finally:
+            hal_unlock()
+        return out
+
+
+_KIND_CLASS = {K_COMP: Component, K_INST: Instance, K_PIN: Pin,
+               K_PARAM: Param, K_SIG: Signal, K_FUNCT: Function,
+               K_THREAD: Thread}
+
+
+# ---------------------------------------------------------------- instance
+
+def create(str shm_name, str instance, long size=0):
+    """Create the instance and become its host."""
+    check(hal_instance_create(enc(shm_name), enc(instance), size))
+
+
+def attach(str shm_name):
+    """Map an existing instance."""
+    check(hal_instance_attach(enc(shm_name)))
+
+
+def detach(bint unlink=False, shm_name=None):
+    """Unmap the instance; the host also removes it."""
+    cdef bytes b
+    if shm_name:
+        b = enc(shm_name)
+        hal_instance_detach(unlink, b)
+    else:
+        hal_instance_detach(0, NULL)
+
+
+def probe(str shm_name):
+    """(host_pid, host_start, abi) of an instance, or None if absent.
+
+    Raises InstanceError for a segment that is not a halsdk instance.
+    """
+    cdef int pid = 0, abi = 0
+    cdef uint64_t start = 0
+    r = hal_instance_probe(enc(shm_name), &pid, &start, &abi)
+    if r == -2:
+        return None
+    if r < 0:
+        raise _errors.InstanceError(f"{shm_name} is not a halsdk instance")
+    return pid, start, abi
+
+
+def pid_alive(int pid, uint64_t start=0) -> bool:
+    return hal_pid_alive(pid, start) != 0
+
+
+def proc_start_time(int pid) -> int:
+    return hal_proc_start_time(pid)
+
+
+def attached() -> bool:
+    return hal_map.hdr != NULL
+
+
+def is_host() -> bool:
+    return hal_map.hdr != NULL and hal_map.is_host != 0
+
+
+def info() -> dict:
+    """Facts about the attached instance."""
+    need_instance()
+    cdef hal_header_t *h = hal_map.hdr
+    return {
+        "instance": h.instance.decode(),
+        "size": h.size,
+        "abi": h.abi,
+        "host_pid": h.host_pid,
+        "host_start": h.host_start,
+        "serial": h.serial,
+        "lock": h.lock,
+        "bytes_used": h.bytes_used,
+        "heap_top": h.heap_top,
+        "heap_end": h.heap_end,
+        "counts": {KIND_WORDS[k]: h.count[k] for k in KIND_WORDS},
+        "sim_time": h.sim_time,
+        "simulated_clock": h.sim_clock != 0,
+        "threads_running": h.threads_running != 0,
+        "recovered": h.recovered,
+        "msg_level": h.msg_level,
+    }
+
+
+def set_msg_level(int level):
+    need_instance()
+    if not 0 <= level <= 5:
+        raise _errors.InvalidError(f"message level {level} is not 0..5")
+    hal_map.hdr.msg_level = level
+
+
+def serial() -> int:
+    need_instance()
+    return hal_map.hdr.serial
+
+
+def get_time() -> int:
+    """rtapi_get_time(): ns; simulated time while stepping."""
+    return hal_get_time()
+
+
+def hold_lock_for_test(double seconds):
+    """Hold the instance mutex (tests kill a holder to check recovery)."""
+    need_instance()
+    cdef int r
+    with nogil:
+        r = hal_hold_lock_for_test(seconds)
+    check(r)
+
+
+def check_consistency():
+    """(number of problems, last problem) of the instance invariants."""
+    need_instance()
+    cdef char rep[512]
+    n = hal_check_consistency(rep, sizeof(rep))
+    return n, rep.decode("utf-8", "replace")
+
+
+# ---------------------------------------------------------------- lookup
+
+_KIND_BY_WORD = {v: k for k, v in KIND_WORDS.items()}
+
+
+def find(str kind, name):
+    """The handle of a named object, or None."""
+    need_instance()
+    cdef int k = _KIND_BY_WORD[kind]
+    cdef bytes b = enc(name)
+    cdef void *p
+    hal_lock()
+    try:
+        p = hal_find(k, b)
+        return make(k, p) if p != NULL else None
+    finally:
+        hal_unlock()
+
+
+def items(str kind):
+    """Handles of every object of a kind, in creation order."""
+    need_instance()
+    cdef int k = _KIND_BY_WORD[kind]
+    cdef hoff_t o
+    cdef hal_obj_t *obj
+    out = []
+    hal_lock()
+    try:
+        o = hal_map.hdr.list_head[k]
+        while o:
+            obj = <hal_obj_t *>SHMPTR(o)
+            out.append(make(k, obj))
+            o = obj.next
+    finally:
+        hal_unlock()
+    return out
+
+
+def comp_by_id(int id):
+    need_instance()
+    cdef hal_comp_t *c
+    hal_lock()
+    try:
+        c = hal_comp_by_id(id)
+        return make(K_COMP, c) if c != NULL else None
+    finally:
+        hal_unlock()
+
+
+def check_name(name, str what="object"):
+    check(hal_check_name(enc(name), enc(what)))
+
+
+# ---------------------------------------------------------------- changes
+
+def comp_new(name, int kind):
+    need_instance()
+    return check(hal_comp_new(enc(name), kind))
+
+
+def comp_exit(int comp_id):
+    need_instance()
+    _drop_python_functs(comp_id)
+    cdef int r
+    with nogil:
+        r = hal_comp_exit(comp_id)
+    check(r)
+
+
+def comp_ready(int comp_id, bint ready=True):
+    need_instance()
+    check(hal_comp_set_ready(comp_id, ready))
+
+
+def inst_new(name, int comp_id):
+    need_instance()
+    return check(hal_inst_new(enc(name), comp_id))
+
+
+def inst_delete(name):
+    need_instance()
+    cdef bytes b = enc(name)
+    cdef const char *cb = b
+    cdef int r
+    with nogil:
+        r = hal_inst_delete(cb)
+    check(r)
+
+
+def pin_new(name, int type, int dir, int owner_id):
+    """Create a pin whose pointer cell is allocated for the owner."""
+    need_instance()
+    cdef bytes b = enc(name)
+    check(hal_check_name(b, b"pin"))
+    cdef void **cell = <void **>hal_malloc_owned(sizeof(void *), owner_id)
+    if cell == NULL:
+        check(-12)
+    check(hal_pin_new(b, type, dir, cell, owner_id))
+    return find("pin", name)
+
+
+def param_new(name, int type, int dir, int owner_id):
+    """Create a param whose value is allocated for the owner."""
+    need_instance()
+    cdef bytes b = enc(name)
+    check(hal_check_name(b, b"param"))
+    cdef void *data = hal_malloc_owned(8, owner_id)
+    if data == NULL:
+        check(-12)
+    check(hal_param_new(b, type, dir, data, owner_id))
+    return find("param", name)
+
+
+def alias(str kind, name, alias_name):
+    need_instance()
+    check(hal_alias(_KIND_BY_WORD[kind], enc(name), enc(alias_name)))
+
+
+def unalias(str kind, alias_name):
+    need_instance()
+    check(hal_unalias(_KIND_BY_WORD[kind], enc(alias_name)))
+
+
+def signal_new(name, int type):
+    need_instance()
+    check(hal_signal_new(enc(name), type))
+    return find("signal", name)
+
+
+def signal_delete(name):
+    need_instance()
+    check(hal_signal_delete(enc(name)))
+
+
+def link(pin, sig):
+    need_instance()
+    check(hal_link(enc(pin), enc(sig)))
+
+
+def unlink(pin):
+    need_instance()
+    check(hal_unlink(enc(pin)))
+
+
+def set_lock(int level):
+    need_instance()
+    if not 0 <= level <= 255:
+        raise _errors.InvalidError(f"lock level {level} is not 0..255")
+    check(hal_set_lock(level))
+
+
+def get_lock() -> int:
+    need_instance()
+    return hal_map.hdr.lock
+
+
+def set_loading_rt(bint on):
+    """Mark hal_init() calls of a module being loaded as realtime."""
+    global hal_loading_rt
+    hal_loading_rt = on
+
+
+# ---------------------------------------------------------------- threads
+
+_python_functs = {}     # funct name -> (owner id, callable state)
+
+
+cdef class _PyFunct:
+    cdef object fn
+    cdef str name
+    cdef bint reported
+    cdef public long errors
+
+
+cdef void py_trampoline(void *arg, long period) noexcept nogil:
+    with gil:
+        pf = <_PyFunct>arg
+        try:
+            pf.fn(period)
+        except BaseException:
+            pf.errors += 1
+            if not pf.reported:
+                pf.reported = True
+                sys.stderr.write(f"halsdk: Python function '{pf.name}' "
+                                 "raised (reported once):\n")
+                traceback.print_exc()
+
+
+def export_python(name, fn, int owner_id, bint uses_fp=True):
+    """Export a Python callable ``fn(period_ns)`` as a (non-realtime)
+    function; it takes the GIL on every call."""
+    need_instance()
+    if not callable(fn):
+        raise _errors.InvalidError(f"function '{name}': {fn!r} is not "
+                                   "callable")
+    pf = _PyFunct()
+    pf.fn = fn
+    pf.name = name
+    check(hal_export_funct(enc(name), py_trampoline, <void *>pf, uses_fp,
+                           0, owner_id, 1))
+    _python_functs[name] = (owner_id, pf)
+
+
+def python_funct_errors(name) -> int:
+    entry = _python_functs.get(name)
+    return entry[1].errors if entry else 0
+
+
+def _drop_python_functs(int comp_id):
+    for n in [n for n, (o, _) in _python_functs.items() if o == comp_id]:
+        del _python_functs[n]
+
+
+def thread_new(name, long period, bint uses_fp=True,
+               unsigned int timing_every=1):
+    need_instance()
+    check(hal_thread_new(enc(name), period, uses_fp, timing_every))
+    return find("thread", name)
+
+
+def thread_delete(name):
+    need_instance()
+    cdef bytes b = enc(name)
+    cdef const char *cb = b
+    cdef int r
+    with nogil:
+        r = hal_thread_delete(cb)
+    check(r)
+
+
+def addf(funct, thread, int position=-1):
+    need_instance()
+    cdef bytes f = enc(funct), t = enc(thread)
+    cdef const char *cf = f
+    cdef const char *ct = t
+    cdef int r
+    with nogil:
+        r = hal_addf(cf, ct, position)
+    check(r)
+
+
+def delf(funct, thread):
+    need_instance()
+    cdef bytes f = enc(funct), t = enc(thread)
+    cdef const char *cf = f
+    cdef const char *ct = t
+    cdef int r
+    with nogil:
+        r = hal_delf(cf, ct)
+    check(r)
+
+
+def start(bint realtime=True):
+    """Start every thread; returns a note when realtime was not granted."""
+    need_instance()
+    cdef char note[256]
+    cdef int r
+    note[0] = 0
+    with nogil:
+        r = exec_start_all(realtime, note, sizeof(note))
+    check(r)
+    return note.decode() or None
+
+
+def stop():
+    need_instance()
+    cdef int r
+    with nogil:
+        r = hal_stop_threads()
+    check(r)
+
+
+def step(long n=1, thread=None):
+    """Run threads for n cycles with simulated time, without sleeping."""
+    need_instance()
+    if n < 0:
+        raise _errors.InvalidError(f"cannot step {n} cycles")
+    cdef int r
+    cdef int slot
+    cdef long cycles = n
+    if thread is None:
+        with nogil:
+            r = exec_step_all(cycles)
+    else:
+        t = find("thread", thread)
+        if t is None:
+            raise _errors.NotFoundError(f"thread '{thread}' not found")
+        slot = (<hal_thread_t *>(<Item>t).rec()).slot
+        with nogil:
+            r = exec_run_cycles(slot, cycles)
+    check(r)

@@ -1,0 +1,182 @@
+"""The request channel from attached processes to the host.
+
+Changes that concern realtime modules (load, unload, addf, delf, start,
+stop, newinst, delinst, threads) are executed by the host, which owns the
+realtime threads and the loaded modules.  An attached process sends the
+request over a Unix-domain socket in a directory only the user can enter
+(mode 0700) and gets the result or the error back.  Nothing listens on a
+network port.
+
+Protocol: one JSON object per line each way.  Request
+``{"op": name, "args": [...], "kwargs": {...}}``; reply
+``{"ok": true, "result": ...}`` or
+``{"ok": false, "error": message, "class": exception class name}``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import socket
+import stat
+import struct
+import threading
+from typing import Any
+
+from halsdk import errors
+
+_MAX_REQUEST = 1 << 20
+
+
+def socket_dir() -> str:
+    """The private directory of this user's request sockets."""
+    base = os.environ.get("XDG_RUNTIME_DIR")
+    if base and os.path.isdir(base) and os.access(base, os.W_OK):
+        path = os.path.join(base, "halsdk")
+    else:
+        path = f"/tmp/halsdk-{os.getuid()}"
+    try:
+        os.mkdir(path, 0o700)
+    except FileExistsError:
+        pass
+    st = os.lstat(path)
+    if not stat.S_ISDIR(st.st_mode) or st.st_uid != os.getuid():
+        raise errors.InstanceError(
+            f"{path} is not a directory owned by this user; refusing to "
+            "use it for the HAL request channel")
+    if stat.S_IMODE(st.st_mode) & 0o077:
+        os.chmod(path, 0o700)
+    return path
+
+
+def socket_path(shm: str) -> str:
+    return os.path.join(socket_dir(), shm.lstrip("/") + ".sock")
+
+
+def remove_socket(shm: str) -> None:
+    try:
+        os.unlink(socket_path(shm))
+    except (FileNotFoundError, errors.InstanceError):
+        pass
+
+
+class Server:
+    """Serves requests on the host, one at a time, in a daemon thread."""
+
+    def __init__(self, conn):
+        self.conn = conn
+        self.path = socket_path(conn.shm)
+        try:
+            os.unlink(self.path)
+        except FileNotFoundError:
+            pass
+        self.sock = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+        old = os.umask(0o077)
+        try:
+            self.sock.bind(self.path)
+        finally:
+            os.umask(old)
+        self.sock.listen(16)
+        self.sock.settimeout(0.2)
+        self.stopping = False
+        self.thread = threading.Thread(target=self._serve,
+                                       name="halsdk-requests", daemon=True)
+        self.thread.start()
+
+    def close(self) -> None:
+        if self.stopping:
+            return
+        self.stopping = True
+        if threading.current_thread() is not self.thread:
+            self.thread.join(timeout=5)
+        self.sock.close()
+        try:
+            os.unlink(self.path)
+        except FileNotFoundError:
+            pass
+
+    def _serve(self) -> None:
+        while not self.stopping:
+            try:
+                client, _ = self.sock.accept()
+            except (socket.timeout, OSError):
+                continue
+            with client:
+                client.settimeout(30)
+                try:
+                    self._handle(client)
+                except (OSError, ValueError):
+                    pass
+
+    def _handle(self, client: socket.socket) -> None:
+        creds = client.getsockopt(socket.SOL_SOCKET, socket.SO_PEERCRED,
+                                  struct.calcsize("3i"))
+        _pid, uid, _gid = struct.unpack("3i", creds)
+        if uid != os.getuid():
+            return
+        reader = client.makefile("rb")
+        while True:
+            line = reader.readline(_MAX_REQUEST)
+            if not line:
+                return
+            reply = self._dispatch(line)
+            client.sendall(json.dumps(reply).encode() + b"\n")
+
+    def _dispatch(self, line: bytes) -> dict:
+        try:
+            req = json.loads(line)
+            op = req["op"]
+            args = req.get("args", [])
+            kwargs = req.get("kwargs", {})
+            if not isinstance(args, list) or not isinstance(kwargs, dict):
+                raise ValueError("args must be a list, kwargs an object")
+        except (ValueError, KeyError, TypeError) as exc:
+            return {"ok": False, "error": f"bad request: {exc}",
+                    "class": "InvalidError"}
+        handler = self.conn.handlers.get(op)
+        if handler is None:
+            return {"ok": False, "class": "InvalidError",
+                    "error": f"the host does not serve request '{op}'"}
+        try:
+            return {"ok": True, "result": handler(*args, **kwargs)}
+        except Exception as exc:
+            return {"ok": False, "error": str(exc),
+                    "class": type(exc).__name__}
+
+
+def request(shm: str, op: str, *args: Any, timeout: float = 60.0,
+            **kwargs: Any) -> Any:
+    """Ask the host of an instance to do ``op``; raise its error."""
+    path = socket_path(shm)
+    sock = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    sock.settimeout(timeout)
+    try:
+        try:
+            sock.connect(path)
+        except OSError as exc:
+            raise errors.InstanceError(
+                f"cannot reach the host of the HAL instance ({path}): "
+                f"{exc.strerror or exc}") from None
+        msg = {"op": op, "args": list(args), "kwargs": kwargs}
+        sock.sendall(json.dumps(msg).encode() + b"\n")
+        data = b""
+        while not data.endswith(b"\n"):
+            try:
+                chunk = sock.recv(65536)
+            except socket.timeout:
+                raise errors.InstanceError(
+                    f"the host did not answer request '{op}' within "
+                    f"{timeout:g} s") from None
+            if not chunk:
+                raise errors.InstanceError(
+                    f"the host closed the channel during request '{op}'")
+            data += chunk
+    finally:
+        sock.close()
+    reply = json.loads(data)
+    if reply.get("ok"):
+        return reply.get("result")
+    cls = getattr(errors, reply.get("class", ""), None)
+    if not (isinstance(cls, type) and issubclass(cls, errors.HalError)):
+        cls = errors.HalError
+    raise cls(reply.get("error", "request failed"))

@@ -1,0 +1,511 @@
+"""The Python API of a HAL instance: :class:`Hal`."""
+
+from __future__ import annotations
+
+import fnmatch
+import os
+import signal as _signal
+import time
+from typing import Any, Callable, Iterable, Optional, Union
+
+from halsdk import _core, channel, instance
+from halsdk.errors import (ConflictError, HalTypeError, InvalidError,
+                           NotFoundError, NotPermittedError)
+from halsdk.loader import Registry
+from halsdk.types import Direction, HalType, parse_type
+
+Value = Union[bool, int, float, str]
+
+# requests an attached process forwards to the host
+_HOST_OPS = ("loadrt", "unloadrt", "unload", "newinst", "delinst",
+             "newthread", "delthread", "addf", "delf", "start", "stop",
+             "step")
+
+
+class Hal:
+    """A HAL instance: create it (become its host) or attach to it.
+
+    ``Hal()`` attaches to the user's instance when one runs, otherwise it
+    creates it and this process becomes the host: it runs the realtime
+    threads and loads realtime modules.  An attached process sends those
+    operations to the host; everything else (values, links, signals,
+    listing) it does directly in shared memory.
+
+    Use it as a context manager or call :meth:`close`; the host removes
+    the instance when it closes or the process exits.
+
+    :param instance: instance name (default ``$HALSDK_INSTANCE`` or the
+        user's default instance).
+    :param create: True: must create; False: must attach; None: either.
+    :param size: size of a new instance in bytes (default 160 MiB, enough
+        for well over 100,000 pins; pages are used only when touched).
+    """
+
+    def __init__(self, instance: Optional[str] = None, *,
+                 create: Optional[bool] = None, size: Optional[int] = None):
+        from halsdk import instance as inst_mod
+        self._conn = inst_mod.connect(instance, create=create, size=size)
+        self._closed = False
+        conn = self._conn
+        with conn.lock:
+            if conn.host and not hasattr(conn, "registry"):
+                conn.registry = Registry()
+                conn.closers.append(conn.registry.unload_all)
+                for op in _HOST_OPS:
+                    conn.handlers[op] = getattr(self, "_host_" + op)
+                conn.handlers["ping"] = lambda: os.getpid()
+
+    # ------------------------------------------------------------ lifetime
+
+    def close(self) -> None:
+        """Stop using the instance (the host also removes it)."""
+        if not self._closed:
+            self._closed = True
+            instance.release(self._conn)
+
+    def __enter__(self) -> Hal:
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.close()
+
+    @property
+    def is_host(self) -> bool:
+        """True in the process that created the instance."""
+        return self._conn.host
+
+    @property
+    def instance(self) -> str:
+        return self._conn.label
+
+    def info(self) -> dict:
+        """Size, usage, counts, host pid and clock state of the instance."""
+        return _core.info()
+
+    def _call_host(self, op: str, *args: Any, **kwargs: Any) -> Any:
+        if self._conn.host:
+            return getattr(self, "_host_" + op)(*args, **kwargs)
+        return channel.request(self._conn.shm, op, *args, **kwargs)
+
+    # ------------------------------------------------------------ modules
+
+    def loadrt(self, name: str, *args: str, **modparams: Any) -> list[str]:
+        """Load a realtime component module; returns the components made.
+
+        Parameters come as ``"count=2"`` words, keywords, or both:
+        ``hal.loadrt("and2", count=2)``.
+        """
+        if " " in name.strip():
+            first, _, rest = name.strip().partition(" ")
+            name, args = first, (rest,) + args
+        return self._call_host("loadrt", name, *args, **modparams)
+
+    def _host_loadrt(self, name: str, *args: str, **kw: Any) -> list[str]:
+        with self._conn.lock:
+            return self._conn.registry.load(name, *args, **kw)
+
+    def unloadrt(self, name: str) -> None:
+        """Unload a realtime module (``"all"``: every module)."""
+        self._call_host("unloadrt", name)
+
+    def _host_unloadrt(self, name: str) -> None:
+        with self._conn.lock:
+            if name == "all":
+                self._conn.registry.unload_all()
+            else:
+                self._conn.registry.unload(name)
+
+    def unload(self, name: str, timeout: float = 5.0) -> None:
+        """Remove a component of any kind (``"all"``: every component).
+
+        A realtime module is unloaded; a userspace component of a live
+        process is asked to exit (SIGTERM) and awaited; one whose process
+        is gone is removed directly.
+        """
+        self._call_host("unload", name, timeout)
+
+    def _host_unload(self, name: str, timeout: float = 5.0) -> None:
+        with self._conn.lock:
+            registry = self._conn.registry
+            if name == "all":
+                registry.unload_all()
+                for comp in _core.items("component"):
+                    if comp.exists and not comp.name.startswith("__"):
+                        self._remove_user_comp(comp.name, timeout)
+                return
+            loaded = registry.module_of_comp(name)
+            if loaded is not None:
+                registry.unload(loaded.name)
+                return
+            if name in registry.modules:
+                registry.unload(name)
+                return
+            self._remove_user_comp(name, timeout)
+
+    def _remove_user_comp(self, name: str, timeout: float) -> None:
+        comp = _core.find("component", name)
+        if comp is None:
+            raise NotFoundError(f"component '{name}' not found")
+        if comp.name.startswith("__"):
+            raise NotPermittedError(f"component '{name}' belongs to a "
+                                    "thread; delete the thread instead")
+        if comp.pid == os.getpid() or not comp.alive:
+            _core.comp_exit(comp.id)
+            return
+        os.kill(comp.pid, _signal.SIGTERM)
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            if not comp.exists:
+                return
+            if not comp.alive:
+                _core.comp_exit(comp.id)
+                return
+            time.sleep(0.01)
+        raise ConflictError(f"component '{name}' (pid {comp.pid}) did not "
+                            f"exit within {timeout:g} s of SIGTERM")
+
+    def newinst(self, comp: str, name: str, *args: str, **kw: Any) -> None:
+        """Add an instance to a loaded component that supports it."""
+        self._call_host("newinst", comp, name, *args, **kw)
+
+    def _host_newinst(self, comp: str, name: str, *args: str,
+                      **kw: Any) -> None:
+        from halsdk.loader import parse_modparams
+        with self._conn.lock:
+            loaded = self._conn.registry.module_of_comp(comp)
+            if loaded is None:
+                raise NotFoundError(f"component '{comp}' is not a loaded "
+                                    "realtime component")
+            hook = getattr(loaded.module, "new_instance", None)
+            if not callable(hook):
+                raise NotPermittedError(f"component '{comp}' does not "
+                                        "support instances (newinst)")
+            params = parse_modparams(comp, _InstParams(loaded.module),
+                                     args, kw)
+            _core.set_loading_rt(True)
+            try:
+                hook(name, **params)
+            finally:
+                _core.set_loading_rt(False)
+
+    def delinst(self, name: str) -> None:
+        """Remove an instance made by :meth:`newinst`."""
+        self._call_host("delinst", name)
+
+    def _host_delinst(self, name: str) -> None:
+        with self._conn.lock:
+            inst = _core.find("instance", name)
+            if inst is None:
+                raise NotFoundError(f"instance '{name}' not found")
+            loaded = self._conn.registry.module_of_comp(inst.owner)
+            _core.inst_delete(name)
+            hook = getattr(loaded.module, "delete_instance", None) \
+                if loaded else None
+            if callable(hook):
+                hook(name)
+
+    # ------------------------------------------------------------ threads
+
+    def newthread(self, name: str, period: int, fp: bool = True,
+                  timing_every: int = 16) -> None:
+        """Create a thread running every ``period`` ns.
+
+        Per-function ``.time``/``.tmax`` are measured every
+        ``timing_every``-th cycle (1: every cycle, as the reference does);
+        the thread's own time and tmax are measured every cycle.
+        """
+        self._call_host("newthread", name, period, fp, timing_every)
+
+    def _host_newthread(self, name: str, period: int, fp: bool = True,
+                        timing_every: int = 16) -> None:
+        if not isinstance(period, int) or isinstance(period, bool):
+            raise InvalidError(f"thread '{name}': period must be an "
+                               f"integer of ns, not {period!r}")
+        if not 1 <= timing_every <= 1_000_000:
+            raise InvalidError(f"thread '{name}': timing_every must be "
+                               "1..1000000")
+        _core.thread_new(name, period, fp, timing_every)
+
+    def delthread(self, name: str) -> None:
+        self._call_host("delthread", name)
+
+    def _host_delthread(self, name: str) -> None:
+        _core.thread_delete(name)
+
+    def addf(self, funct: str, thread: str, position: int = -1) -> None:
+        """Add a function to a thread; position 1 is first, -1 last."""
+        self._call_host("addf", funct, thread, position)
+
+    def _host_addf(self, funct: str, thread: str, position: int = -1):
+        _core.addf(funct, thread, position)
+
+    def delf(self, funct: str, thread: str) -> None:
+        self._call_host("delf", funct, thread)
+
+    def _host_delf(self, funct: str, thread: str) -> None:
+        _core.delf(funct, thread)
+
+    def start(self, realtime: bool = True) -> Optional[str]:
+        """Start every thread in real time.
+
+        SCHED_FIFO and locked memory are used when the process may;
+        otherwise threads run with normal scheduling and a note is printed
+        to stderr and returned.
+        """
+        return self._call_host("start", realtime)
+
+    def _host_start(self, realtime: bool = True) -> Optional[str]:
+        note = _core.start(realtime)
+        if note:
+            import sys
+            print(note, file=sys.stderr)
+        return note
+
+    def stop(self) -> None:
+        """Stop every thread."""
+        self._call_host("stop")
+
+    def _host_stop(self) -> None:
+        _core.stop()
+
+    def step(self, n: int = 1, thread: Optional[str] = None) -> None:
+        """Run threads synchronously with exact simulated time.
+
+        Without ``thread``: advance the simulated clock by ``n`` periods
+        of the fastest thread, running every thread whose cycle falls due
+        (faster first at equal times).  With ``thread``: run that thread
+        ``n`` cycles.  Functions get the exact nominal period;
+        ``rtapi_get_time()`` returns the simulated time.
+        """
+        self._call_host("step", n, thread)
+
+    def _host_step(self, n: int = 1, thread: Optional[str] = None) -> None:
+        _core.step(n, thread)
+
+    def run_for(self, seconds: float) -> None:
+        """Step the threads for ``seconds`` of simulated time."""
+        threads = _core.items("thread")
+        if not threads:
+            raise NotFoundError("there are no threads to step")
+        base = min(t.period for t in threads)
+        self.step(max(1, round(seconds * 1e9 / base)))
+
+    @property
+    def time(self) -> int:
+        """rtapi_get_time() in ns: simulated time after stepping."""
+        return _core.get_time()
+
+    def add_python_function(self, name: str, fn: Callable[[int], None],
+                            thread: Optional[str] = None, fp: bool = True,
+                            position: int = -1) -> None:
+        """Export ``fn(period_ns)`` as a HAL function (not realtime: it
+        takes the GIL) and optionally add it to a thread."""
+        if not self._conn.host:
+            raise NotPermittedError(f"function '{name}': Python functions "
+                                    "run in the host process")
+        comp = _core.find("component", "__python")
+        if comp is None:
+            _core.set_loading_rt(True)
+            try:
+                cid = _core.comp_new("__python", _core.COMP_RT)
+            finally:
+                _core.set_loading_rt(False)
+        else:
+            cid = comp.id
+            _core.comp_ready(cid, False)
+        try:
+            _core.export_python(name, fn, cid, fp)
+        finally:
+            _core.comp_ready(cid, True)
+        if thread is not None:
+            self.addf(name, thread, position)
+
+    # ------------------------------------------------------------ signals
+
+    def newsig(self, name: str, type: Union[str, int]) -> _core.Signal:
+        """Create a signal of a type ("bit", "float", "s32", ...)."""
+        return _core.signal_new(name, parse_type(type))
+
+    def delsig(self, name: str) -> None:
+        """Delete a signal, unlinking its pins (``"all"``: every one)."""
+        if name == "all":
+            for sig in _core.items("signal"):
+                _core.signal_delete(sig.name)
+        else:
+            _core.signal_delete(name)
+
+    def net(self, signal: str, *pins: str) -> _core.Signal:
+        """Link pins to a signal, creating it with the first pin's type.
+
+        Arrow words (``=>``, ``<=``, ``<=>``) are accepted and ignored.
+        All checks are made before anything changes.
+        """
+        pins = tuple(p for p in pins if p not in ("=>", "<=", "<=>"))
+        if not pins:
+            raise InvalidError(f"net '{signal}': no pins given")
+        handles = []
+        for name in pins:
+            pin = _core.find("pin", name)
+            if pin is None:
+                raise NotFoundError(f"pin '{name}' not found")
+            handles.append(pin)
+        sig = _core.find("signal", signal)
+        if sig is not None and _core.find("pin", signal) is not None:
+            raise ConflictError(f"'{signal}' is both a signal and a pin")
+        stype = sig.type if sig is not None else handles[0].type
+        writers = sig.writers if sig is not None else 0
+        bidirs = sig.bidirs if sig is not None else 0
+        for pin in handles:
+            if pin.type != stype:
+                raise HalTypeError(
+                    f"Signal '{signal}' of type "
+                    f"'{_core.TYPE_NAMES[stype]}' cannot add pin "
+                    f"'{pin.name}' of type '{_core.TYPE_NAMES[pin.type]}'")
+            linked = pin.signal
+            if linked is not None and linked.name != signal:
+                raise ConflictError(f"Pin '{pin.name}' was already linked "
+                                    f"to signal '{linked.name}'")
+            if linked is None:
+                writers += pin.direction == _core.OUT
+                bidirs += pin.direction == _core.IO
+        if writers > 1:
+            raise ConflictError(f"net '{signal}': more than one output pin "
+                                "would drive the signal")
+        if writers and bidirs:
+            raise ConflictError(f"net '{signal}': an output pin and I/O "
+                                "pins cannot share a signal")
+        if sig is None:
+            sig = _core.signal_new(signal, stype)
+        for pin in handles:
+            _core.link(pin.name, signal)
+        return sig
+
+    def linkps(self, pin: str, signal: str) -> None:
+        _core.link(pin, signal)
+
+    def linksp(self, signal: str, pin: str) -> None:
+        _core.link(pin, signal)
+
+    def unlinkp(self, pin: str) -> None:
+        _core.unlink(pin)
+
+    def sets(self, name: str, value: Value) -> None:
+        """Set a signal that has no writer."""
+        self._need("signal", name).sets(value)
+
+    def gets(self, name: str) -> Value:
+        return self._need("signal", name).value
+
+    def stype(self, name: str) -> str:
+        return _core.TYPE_NAMES[self._need("signal", name).type]
+
+    # ------------------------------------------------------------ values
+
+    def _item(self, name: str):
+        item = _core.find("param", name) or _core.find("pin", name)
+        if item is None:
+            raise NotFoundError(f"pin or param '{name}' not found")
+        return item
+
+    def setp(self, name: str, value: Value) -> None:
+        """Set a param, or an unlinked in/io pin, as ``halcmd setp``."""
+        self._item(name).setp(value)
+
+    def getp(self, name: str) -> Value:
+        return self._item(name).value
+
+    def ptype(self, name: str) -> str:
+        return _core.TYPE_NAMES[self._item(name).type]
+
+    def alias(self, kind: str, name: str, alias: str) -> None:
+        """Give a pin or param (kind ``"pin"``/``"param"``) a new name."""
+        if kind not in ("pin", "param"):
+            raise InvalidError(f"alias: kind must be 'pin' or 'param', "
+                               f"not {kind!r}")
+        _core.alias(kind, name, alias)
+
+    def unalias(self, kind: str, alias: str) -> None:
+        if kind not in ("pin", "param"):
+            raise InvalidError(f"unalias: kind must be 'pin' or 'param', "
+                               f"not {kind!r}")
+        _core.unalias(kind, alias)
+
+    def lock(self, level: int = 255) -> None:
+        """Lock the instance (bits: 1 load, 2 config, 4 params, 8 run)."""
+        _core.set_lock(level)
+
+    def unlock(self) -> None:
+        _core.set_lock(0)
+
+    # ------------------------------------------------------------ lookup
+
+    def _need(self, kind: str, name: str):
+        item = _core.find(kind, name)
+        if item is None:
+            raise NotFoundError(f"{kind} '{name}' not found")
+        return item
+
+    def pin(self, name: str) -> _core.Pin:
+        return self._need("pin", name)
+
+    def param(self, name: str) -> _core.Param:
+        return self._need("param", name)
+
+    def signal(self, name: str) -> _core.Signal:
+        return self._need("signal", name)
+
+    def component(self, name: str) -> _core.Component:
+        return self._need("component", name)
+
+    def function(self, name: str) -> _core.Function:
+        return self._need("function", name)
+
+    def thread(self, name: str) -> _core.Thread:
+        return self._need("thread", name)
+
+    @staticmethod
+    def _list(kind: str, pattern: Union[str, Iterable[str]]) -> list:
+        pats = [pattern] if isinstance(pattern, str) else list(pattern)
+        found = [it for it in _core.items(kind)
+                 if any(fnmatch.fnmatchcase(it.name, p) for p in pats)]
+        return sorted(found, key=lambda it: it.name)
+
+    def pins(self, pattern: Union[str, Iterable[str]] = "*") -> list:
+        """Pins whose names match a glob pattern, sorted by name."""
+        return self._list("pin", pattern)
+
+    def params(self, pattern: Union[str, Iterable[str]] = "*") -> list:
+        return self._list("param", pattern)
+
+    def signals(self, pattern: Union[str, Iterable[str]] = "*") -> list:
+        return self._list("signal", pattern)
+
+    def components(self, pattern: Union[str, Iterable[str]] = "*") -> list:
+        return self._list("component", pattern)
+
+    def functions(self, pattern: Union[str, Iterable[str]] = "*") -> list:
+        return self._list("function", pattern)
+
+    def threads(self, pattern: Union[str, Iterable[str]] = "*") -> list:
+        return self._list("thread", pattern)
+
+    def instances(self, pattern: Union[str, Iterable[str]] = "*") -> list:
+        return self._list("instance", pattern)
+
+    def check(self) -> None:
+        """Verify the instance's invariants; raise if any is broken."""
+        bad, report = _core.check_consistency()
+        if bad:
+            from halsdk.errors import InstanceError
+            raise InstanceError(f"HAL instance is inconsistent ({bad} "
+                                f"problems): {report}")
+
+
+class _InstParams:
+    """The ``instance_params`` of a module, seen as ``modparams``."""
+
+    def __init__(self, module):
+        self.modparams = getattr(module, "instance_params", None) or {}
+
+
+__all__ = ["Hal", "HalType", "Direction"]

@@ -1,0 +1,50 @@
+/*
+ * rtapi_app.h - module entry points and module parameters.
+ *
+ * A C component defines rtapi_app_main() (called by loadrt after its
+ * module parameters are set) and rtapi_app_exit() (called by unloadrt).
+ * Module parameters are declared with the RTAPI_MP_* macros; each one
+ * registers itself, at load time, in the table of its module that the
+ * halsdk loader reads.
+ */
+#ifndef RTAPI_APP_H
+#define RTAPI_APP_H
+
+#include "rtapi.h"
+#include "halsdk_module.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+int rtapi_app_main(void);
+void rtapi_app_exit(void);
+
+#define HALSDK_MP_(var, kind, count, desc)                                 \
+    static void __attribute__((constructor)) halsdk_mp_reg_##var(void)     \
+    {                                                                      \
+        halsdk_modparam_register(#var, kind, (void *)&(var), count, desc); \
+    }
+
+#define RTAPI_MP_INT(var, desc) HALSDK_MP_(var, 'i', 1, desc)
+#define RTAPI_MP_LONG(var, desc) HALSDK_MP_(var, 'l', 1, desc)
+#define RTAPI_MP_STRING(var, desc) HALSDK_MP_(var, 's', 1, desc)
+#define RTAPI_MP_ARRAY_INT(var, num, desc) HALSDK_MP_(var, 'I', num, desc)
+#define RTAPI_MP_ARRAY_LONG(var, num, desc) HALSDK_MP_(var, 'L', num, desc)
+#define RTAPI_MP_ARRAY_STRING(var, num, desc) HALSDK_MP_(var, 'S', num, desc)
+
+#define MODULE_LICENSE(s) \
+    __attribute__((used)) static const char halsdk_license[] = s
+#define MODULE_AUTHOR(s) \
+    __attribute__((used)) static const char halsdk_author[] = s
+#define MODULE_DESCRIPTION(s) \
+    __attribute__((used)) static const char halsdk_description[] = s
+#define MODULE_INFO(tag, s)
+#define EXPORT_SYMBOL(sym)
+#define EXPORT_SYMBOL_GPL(sym)
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* RTAPI_APP_H */

@@ -1,0 +1,219 @@
+"""The process's connection to a HAL instance: create (host) or attach.
+
+One process uses one instance at a time.  The first :class:`halsdk.Hal`
+(or :func:`halsdk.component`) of a process connects; later ones share the
+connection, which closes when the last user closes it or the process exits.
+"""
+
+from __future__ import annotations
+
+import atexit
+import os
+import re
+import signal
+import threading
+from typing import Callable, Optional
+
+from halsdk import _core
+from halsdk.errors import InstanceError, InvalidError
+
+_INSTANCE_NAME = re.compile(r"^[A-Za-z0-9_.-]{1,40}$")
+SHM_DIR = "/dev/shm"
+
+
+def shm_name(instance: Optional[str] = None) -> str:
+    """POSIX shared-memory name of an instance of this user.
+
+    ``None`` means ``$HALSDK_INSTANCE`` or, if unset, the user's default
+    instance.
+    """
+    name = instance if instance is not None else os.environ.get(
+        "HALSDK_INSTANCE", "")
+    base = f"/halsdk-{os.getuid()}"
+    if not name:
+        return base
+    if not _INSTANCE_NAME.match(name):
+        raise InvalidError(
+            f"instance name {name!r} is not 1..40 characters of "
+            "letters, digits, '_', '.' or '-'")
+    return f"{base}-{name}"
+
+
+def instance_label(shm: str) -> str:
+    """The instance name a shared-memory name stands for."""
+    base = f"/halsdk-{os.getuid()}"
+    return shm[len(base) + 1:] if shm != base else "default"
+
+
+class Connection:
+    """This process's mapping of an instance and what it owns there."""
+
+    def __init__(self, shm: str, host: bool):
+        self.shm = shm
+        self.host = host
+        self.users = 0
+        self.closers: list[Callable[[], None]] = []
+        self.server = None              # request channel, on the host
+        self.handlers: dict[str, Callable] = {}   # requests it serves
+        self.lock = threading.RLock()
+
+    @property
+    def label(self) -> str:
+        return instance_label(self.shm)
+
+
+_conn: Optional[Connection] = None
+_conn_lock = threading.RLock()
+
+
+def current() -> Optional[Connection]:
+    return _conn
+
+
+def connect(instance: Optional[str] = None, create: Optional[bool] = None,
+            size: Optional[int] = None) -> Connection:
+    """Create or attach; ``create``: True must create, False must attach,
+    None creates when there is no instance."""
+    global _conn
+    shm = shm_name(instance)
+    with _conn_lock:
+        if _conn is not None:
+            if _conn.shm != shm:
+                raise InstanceError(
+                    f"this process already uses HAL instance "
+                    f"'{_conn.label}'; one instance per process")
+            if create and not _conn.host:
+                raise InstanceError(
+                    f"HAL instance '{_conn.label}' exists; this process "
+                    "is attached to it, not its host")
+            _conn.users += 1
+            return _conn
+        found = _core.probe(shm)
+        if found is not None:
+            pid, start, abi = found
+            if not _core.pid_alive(pid, start):
+                raise InstanceError(
+                    f"HAL instance '{instance_label(shm)}' was left by a "
+                    f"host (pid {pid}) that is gone; remove it with "
+                    "halsdk.cleanup() or 'halrun -U'")
+            if create:
+                raise InstanceError(
+                    f"HAL instance '{instance_label(shm)}' already has a "
+                    f"host (pid {pid})")
+            _core.attach(shm)
+            conn = Connection(shm, host=False)
+        else:
+            if create is False:
+                raise InstanceError(
+                    f"no HAL instance '{instance_label(shm)}' is running "
+                    "(start one with halrun or halsdk.Hal())")
+            _core.create(shm, instance_label(shm), size or 0)
+            conn = Connection(shm, host=True)
+            _install_sigterm()
+        conn.users = 1
+        _conn = conn
+        if conn.host:
+            from halsdk import channel
+            try:
+                conn.server = channel.Server(conn)
+            except Exception:
+                _teardown(conn)
+                raise
+        return conn
+
+
+def release(conn: Connection) -> None:
+    """One user is done; the last one closes the connection."""
+    with _conn_lock:
+        if conn is not _conn:
+            return
+        conn.users -= 1
+        if conn.users <= 0:
+            _teardown(conn)
+
+
+def _teardown(conn: Connection) -> None:
+    global _conn
+    with _conn_lock:
+        if _conn is not conn:
+            return
+        if conn.host:
+            if conn.server is not None:
+                conn.server.close()
+            try:
+                _core.stop()
+            except Exception:
+                pass
+        # closers run newest first: loaded modules, then components
+        while conn.closers:
+            closer = conn.closers.pop()
+            try:
+                closer()
+            except Exception as exc:  # keep tearing down
+                import sys
+                print(f"halsdk: while closing: {exc}", file=sys.stderr)
+        for comp in _core.items("component"):
+            try:
+                if comp.exists and comp.pid == os.getpid():
+                    _core.comp_exit(comp.id)
+            except Exception:
+                pass
+        _core.detach(conn.host, conn.shm if conn.host else None)
+        _conn = None
+
+
+@atexit.register
+def _close_at_exit() -> None:
+    if _conn is not None:
+        _teardown(_conn)
+
+
+def _install_sigterm() -> None:
+    """Let SIGTERM end a host normally so that it removes its instance."""
+    if threading.current_thread() is not threading.main_thread():
+        return
+    if signal.getsignal(signal.SIGTERM) is signal.SIG_DFL:
+        def on_term(signum, frame):
+            raise SystemExit(128 + signum)
+        signal.signal(signal.SIGTERM, on_term)
+
+
+def cleanup(instance: Optional[str] = None) -> list[str]:
+    """Remove instances of this user whose host process is gone.
+
+    With ``instance`` only that one is considered.  Returns the names of
+    the shared-memory segments removed.  Instances with a live host are
+    left alone.
+    """
+    from halsdk import channel
+
+    prefix = f"halsdk-{os.getuid()}"
+    if instance is not None:
+        names = [shm_name(instance)[1:]]
+    else:
+        try:
+            names = [n for n in os.listdir(SHM_DIR)
+                     if n == prefix or n.startswith(prefix + "-")]
+        except FileNotFoundError:
+            names = []
+    removed = []
+    for n in sorted(names):
+        shm = "/" + n
+        if _conn is not None and _conn.shm == shm:
+            continue
+        try:
+            found = _core.probe(shm)
+        except InstanceError:
+            found = (0, 0, 0)           # not an instance: junk of ours
+        if found is None:
+            continue
+        pid, start, _abi = found
+        if pid and _core.pid_alive(pid, start):
+            continue
+        try:
+            os.unlink(os.path.join(SHM_DIR, n))
+            removed.append(n)
+        except FileNotFoundError:
+            pass
+        channel.remove_socket(shm)
+    return removed

@@ -1,0 +1,260 @@
+"""Finding and loading component modules (``loadrt``).
+
+A component module is a Python module (normally a compiled extension) that
+defines:
+
+``modparams``
+    optional; a mapping of parameter name to ``(type, default, doc)``;
+    ``type`` is ``int``, ``float``, ``str``, ``[int]`` or ``[str]`` (a
+    comma-separated list on a load line), or one of the RTAPI kind letters
+    ``i l s I L S``.
+``setup(**params)``
+    creates the component(s): calls ``hal_init``, makes pins, params and
+    functions, calls ``hal_ready``.  Raises (or, for C modules, returns
+    non-zero from ``rtapi_app_main``) on failure.
+``cleanup()``
+    optional; releases what ``setup`` took.  Components it leaves behind
+    are removed by the loader.
+``new_instance(name, **params)`` / ``delete_instance(name)``
+    optional; support for ``newinst``/``delinst``.
+
+Search order for ``loadrt NAME``: the folders of ``$HALSDK_PATH``, the
+user folder that ``halcompile --install`` writes to
+(:func:`user_component_dir`), the shipped ``halsdk.components`` and
+``halsdk.drivers`` packages, then the ``halsdk.components`` entry-point
+group of installed distributions.
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.machinery
+import importlib.util
+import os
+import re
+import sys
+from dataclasses import dataclass, field
+from types import ModuleType
+from typing import Any, Optional
+
+from halsdk import _core
+from halsdk.errors import (ExistsError, HalError, InvalidError, LoadError,
+                           NotFoundError)
+
+_MODULE_NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
+_KINDS = {int: "i", float: "f", str: "s"}
+
+
+def user_component_dir() -> str:
+    """Folder of components installed by ``halcompile --install``."""
+    base = os.environ.get("XDG_DATA_HOME") or os.path.join(
+        os.path.expanduser("~"), ".local", "share")
+    return os.path.join(base, "halsdk", "components")
+
+
+def search_path() -> list[str]:
+    dirs = [d for d in os.environ.get("HALSDK_PATH", "").split(os.pathsep)
+            if d]
+    dirs.append(user_component_dir())
+    return dirs
+
+
+def _find_file(folder: str, name: str) -> Optional[str]:
+    for suffix in importlib.machinery.EXTENSION_SUFFIXES + [".py"]:
+        path = os.path.join(folder, name + suffix)
+        if os.path.isfile(path):
+            return path
+    return None
+
+
+def import_component(name: str) -> ModuleType:
+    """Import the module of component ``name`` by the search order."""
+    if not _MODULE_NAME.match(name):
+        raise InvalidError(f"'{name}' is not a component module name")
+    for folder in search_path():
+        path = _find_file(folder, name)
+        if path:
+            qual = f"halsdk._loaded.{name}"
+            spec = importlib.util.spec_from_file_location(qual, path)
+            if spec is None or spec.loader is None:
+                raise LoadError(f"cannot load component '{name}' from {path}")
+            module = importlib.util.module_from_spec(spec)
+            try:
+                spec.loader.exec_module(module)
+            except Exception as exc:
+                raise LoadError(f"component '{name}' ({path}) failed to "
+                                f"import: {exc}") from exc
+            sys.modules[qual] = module
+            return module
+    for package in ("halsdk.components", "halsdk.drivers"):
+        qual = f"{package}.{name}"
+        try:
+            if importlib.util.find_spec(qual) is None:
+                continue
+        except ModuleNotFoundError:
+            continue
+        try:
+            return importlib.import_module(qual)
+        except Exception as exc:
+            raise LoadError(f"component '{name}' failed to import: "
+                            f"{exc}") from exc
+    from importlib.metadata import entry_points
+    for ep in entry_points(group="halsdk.components"):
+        if ep.name == name:
+            try:
+                return ep.load()
+            except Exception as exc:
+                raise LoadError(f"component '{name}' (entry point "
+                                f"{ep.value}) failed to import: "
+                                f"{exc}") from exc
+    raise NotFoundError(
+        f"component module '{name}' not found (searched HALSDK_PATH, "
+        f"{user_component_dir()}, halsdk.components, halsdk.drivers and "
+        "the 'halsdk.components' entry points)")
+
+
+# ---------------------------------------------------------------- params
+
+def _spec_kind(spec_type: Any) -> str:
+    if isinstance(spec_type, str) and spec_type in "ilsfILSF":
+        return spec_type
+    if isinstance(spec_type, type) and spec_type in _KINDS:
+        return _KINDS[spec_type]
+    if isinstance(spec_type, list) and len(spec_type) == 1 and \
+            spec_type[0] in _KINDS:
+        return _KINDS[spec_type[0]].upper()
+    raise LoadError(f"bad modparam type {spec_type!r}")
+
+
+def _convert(comp: str, pname: str, kind: str, raw: Any) -> Any:
+    if kind.isupper():
+        if isinstance(raw, str):
+            parts = [p for p in raw.split(",")]
+        elif isinstance(raw, (list, tuple)):
+            parts = list(raw)
+        else:
+            parts = [raw]
+        return [_convert(comp, pname, kind.lower(), p) for p in parts]
+    if kind == "s":
+        return str(raw)
+    try:
+        if kind == "f":
+            return float(raw)
+        if isinstance(raw, str):
+            return int(raw.strip(), 0)
+        if isinstance(raw, bool) or not isinstance(raw, int):
+            raise ValueError
+        return raw
+    except ValueError:
+        what = "a number" if kind == "f" else "an integer"
+        raise InvalidError(f"{comp}: parameter {pname}={raw!r} is not "
+                           f"{what}") from None
+
+
+def parse_modparams(name: str, module: ModuleType, args: tuple,
+                    kwargs: dict) -> dict:
+    """Merge ``key=value`` words and keyword arguments, typed by the
+    module's ``modparams``."""
+    spec = getattr(module, "modparams", None) or {}
+    given: dict[str, Any] = {}
+    for word in args:
+        for item in str(word).split():
+            key, sep, value = item.partition("=")
+            if not sep or not key:
+                raise InvalidError(f"{name}: '{item}' is not name=value")
+            given[key] = value
+    given.update(kwargs)
+    out = {}
+    for key, raw in given.items():
+        if key not in spec:
+            known = ", ".join(sorted(spec)) or "none"
+            raise InvalidError(f"{name}: unknown parameter '{key}' "
+                               f"(its parameters: {known})")
+        out[key] = _convert(name, key, _spec_kind(spec[key][0]), raw)
+    return out
+
+
+# ---------------------------------------------------------------- registry
+
+@dataclass
+class Loaded:
+    name: str
+    module: ModuleType
+    comp_ids: list[int] = field(default_factory=list)
+
+
+class Registry:
+    """The modules this host loaded, and which components each made."""
+
+    def __init__(self) -> None:
+        self.modules: dict[str, Loaded] = {}
+
+    def _own_comp_ids(self) -> set[int]:
+        pid = os.getpid()
+        return {c.id for c in _core.items("component") if c.pid == pid}
+
+    def load(self, name: str, *args: Any, **kwargs: Any) -> list[str]:
+        if name in self.modules:
+            raise ExistsError(f"module '{name}' is already loaded")
+        if _core.get_lock() & 1:
+            raise HalError(f"cannot load '{name}': HAL is locked against "
+                           "loading")
+        module = import_component(name)
+        if not callable(getattr(module, "setup", None)):
+            raise LoadError(f"module '{name}' has no setup(): it is not a "
+                            "halsdk component module")
+        params = parse_modparams(name, module, args, kwargs)
+        before = self._own_comp_ids()
+        _core.set_loading_rt(True)
+        try:
+            module.setup(**params)
+            error = None
+        except Exception as exc:
+            error = exc
+        finally:
+            _core.set_loading_rt(False)
+        new = sorted(self._own_comp_ids() - before)
+        if error is None:
+            unready = [_core.comp_by_id(i).name for i in new
+                       if not _core.comp_by_id(i).ready]
+            if unready:
+                error = LoadError(f"{name}: component(s) "
+                                  f"{', '.join(unready)} did not call "
+                                  "hal_ready()")
+        if error is not None:
+            self._undo(module, new)
+            if isinstance(error, HalError):
+                raise type(error)(f"{name}: {error}") from error
+            raise LoadError(f"{name}: setup failed: {error}") from error
+        self.modules[name] = Loaded(name, module, new)
+        return [_core.comp_by_id(i).name for i in new]
+
+    def _undo(self, module: ModuleType, comp_ids: list[int]) -> None:
+        cleanup = getattr(module, "cleanup", None)
+        if callable(cleanup):
+            try:
+                cleanup()
+            except Exception:
+                pass
+        for cid in comp_ids:
+            if _core.comp_by_id(cid) is not None:
+                _core.comp_exit(cid)
+
+    def unload(self, name: str) -> None:
+        loaded = self.modules.pop(name, None)
+        if loaded is None:
+            raise NotFoundError(f"module '{name}' is not loaded")
+        self._undo(loaded.module, loaded.comp_ids)
+
+    def unload_all(self) -> None:
+        for name in reversed(list(self.modules)):
+            self.unload(name)
+
+    def module_of_comp(self, comp_name: str) -> Optional[Loaded]:
+        comp = _core.find("component", comp_name)
+        if comp is None:
+            return None
+        for loaded in self.modules.values():
+            if comp.id in loaded.comp_ids:
+                return loaded
+        return None

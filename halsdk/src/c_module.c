@@ -1,0 +1,269 @@
+/*
+ * c_module.c - the Python entry of a component written in C.
+ *
+ * Compiled together with the component's own C files (which are built
+ * with HALSDK_API_EXTERN so that they share this file's API pointer).
+ * HALSDK_MODULE_NAME is the module (and component) name.  The module
+ * offers what the halsdk loader expects of any component module:
+ *   modparams  {name: (kind, default, description)}, from RTAPI_MP_*
+ *   setup(**params)  sets the parameters, then calls rtapi_app_main()
+ *   cleanup()        calls rtapi_app_exit()
+ */
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "halsdk_api.h"
+#include "halsdk_module.h"
+
+/* built with HALSDK_API_EXTERN like the component's files: define the
+   shared API pointer here */
+const halsdk_api *halsdk_api_ptr;
+
+#define CAT2_(a, b) a##b
+#define CAT_(a, b) CAT2_(a, b)
+#define STR2_(a) #a
+#define STR_(a) STR2_(a)
+
+static halsdk_modparam_t modparams[HALSDK_MAX_MODPARAMS];
+static void *defaults[HALSDK_MAX_MODPARAMS];    /* values at import */
+static int nmodparams;
+static int mp_overflow;
+
+static size_t param_bytes(const halsdk_modparam_t *m)
+{
+    size_t one = (m->kind == 'i' || m->kind == 'I') ? sizeof(int)
+                 : (m->kind == 'l' || m->kind == 'L') ? sizeof(long)
+                 : sizeof(char *);
+    return one * (size_t)(m->count > 0 ? m->count : 1);
+}
+
+/* a module is imported once per process but may be loaded again after
+   an unload: every load starts from the parameters' initial values */
+static int save_defaults(void)
+{
+    for (int i = 0; i < nmodparams; i++) {
+        defaults[i] = malloc(param_bytes(&modparams[i]));
+        if (!defaults[i])
+            return -1;
+        memcpy(defaults[i], modparams[i].addr, param_bytes(&modparams[i]));
+    }
+    return 0;
+}
+
+static void restore_defaults(void)
+{
+    for (int i = 0; i < nmodparams; i++)
+        if (defaults[i])
+            memcpy(modparams[i].addr, defaults[i],
+                   param_bytes(&modparams[i]));
+}
+
+void halsdk_modparam_register(const char *name, char kind, void *addr,
+                              int count, const char *desc)
+{
+    if (nmodparams >= HALSDK_MAX_MODPARAMS) {
+        mp_overflow = 1;
+        return;
+    }
+    halsdk_modparam_t *m = &modparams[nmodparams++];
+    m->name = name;
+    m->kind = kind;
+    m->addr = addr;
+    m->count = count;
+    m->desc = desc;
+}
+
+int rtapi_app_main(void);
+void rtapi_app_exit(void) __attribute__((weak));
+
+static PyObject *scalar_value(char kind, void *addr)
+{
+    switch (kind) {
+    case 'i': case 'I':
+        return PyLong_FromLong(*(int *)addr);
+    case 'l': case 'L':
+        return PyLong_FromLong(*(long *)addr);
+    default: {
+        const char *s = *(char **)addr;
+        return PyUnicode_FromString(s ? s : "");
+    }
+    }
+}
+
+static PyObject *current_value(halsdk_modparam_t *m)
+{
+    if (m->kind == 'i' || m->kind == 'l' || m->kind == 's')
+        return scalar_value(m->kind, m->addr);
+    PyObject *list = PyList_New(0);
+    size_t step = m->kind == 'I' ? sizeof(int)
+                  : m->kind == 'L' ? sizeof(long) : sizeof(char *);
+    for (int k = 0; list && k < m->count; k++) {
+        char *a = (char *)m->addr + k * step;
+        if (m->kind == 'S' && !*(char **)a)
+            break;
+        PyObject *v = scalar_value(m->kind, a);
+        if (!v || PyList_Append(list, v) < 0) {
+            Py_XDECREF(v);
+            Py_DECREF(list);
+            return NULL;
+        }
+        Py_DECREF(v);
+    }
+    return list;
+}
+
+static int set_scalar(halsdk_modparam_t *m, char kind, void *addr,
+                      PyObject *v)
+{
+    if (kind == 's' || kind == 'S') {
+        const char *s = PyUnicode_AsUTF8(v);
+        if (!s)
+            return -1;
+        char *copy = strdup(s);     /* lives as long as the module */
+        if (!copy) {
+            PyErr_NoMemory();
+            return -1;
+        }
+        *(char **)addr = copy;
+        return 0;
+    }
+    long x = PyLong_AsLong(v);
+    if (x == -1 && PyErr_Occurred())
+        return -1;
+    if ((kind == 'i' || kind == 'I') && (x < INT_MIN || x > INT_MAX)) {
+        PyErr_Format(PyExc_ValueError, "parameter %s=%ld is out of range "
+                     "for int", m->name, x);
+        return -1;
+    }
+    if (kind == 'i' || kind == 'I')
+        *(int *)addr = (int)x;
+    else
+        *(long *)addr = x;
+    return 0;
+}
+
+static int set_param(halsdk_modparam_t *m, PyObject *v)
+{
+    if (m->kind == 'i' || m->kind == 'l' || m->kind == 's')
+        return set_scalar(m, m->kind, m->addr, v);
+    PyObject *seq = PySequence_Fast(v, "array parameters take a list");
+    if (!seq)
+        return -1;
+    Py_ssize_t n = PySequence_Fast_GET_SIZE(seq);
+    if (n > m->count) {
+        PyErr_Format(PyExc_ValueError, "parameter %s takes at most %d "
+                     "values, %zd given", m->name, m->count, n);
+        Py_DECREF(seq);
+        return -1;
+    }
+    size_t step = m->kind == 'I' ? sizeof(int)
+                  : m->kind == 'L' ? sizeof(long) : sizeof(char *);
+    for (Py_ssize_t k = 0; k < n; k++) {
+        if (set_scalar(m, m->kind, (char *)m->addr + k * step,
+                       PySequence_Fast_GET_ITEM(seq, k)) < 0) {
+            Py_DECREF(seq);
+            return -1;
+        }
+    }
+    Py_DECREF(seq);
+    return 0;
+}
+
+static PyObject *mod_setup(PyObject *self, PyObject *args, PyObject *kw)
+{
+    if (PyTuple_GET_SIZE(args)) {
+        PyErr_SetString(PyExc_TypeError, "setup() takes parameters by "
+                        "keyword only");
+        return NULL;
+    }
+    PyObject *key, *value;
+    Py_ssize_t pos = 0;
+    restore_defaults();
+    while (kw && PyDict_Next(kw, &pos, &key, &value)) {
+        const char *k = PyUnicode_AsUTF8(key);
+        halsdk_modparam_t *m = NULL;
+        for (int i = 0; k && i < nmodparams; i++)
+            if (strcmp(modparams[i].name, k) == 0)
+                m = &modparams[i];
+        if (!m) {
+            PyErr_Format(PyExc_ValueError, "%s has no parameter '%s'",
+                         STR_(HALSDK_MODULE_NAME), k ? k : "?");
+            return NULL;
+        }
+        if (set_param(m, value) < 0)
+            return NULL;
+    }
+    int r;
+    Py_BEGIN_ALLOW_THREADS
+    r = rtapi_app_main();
+    Py_END_ALLOW_THREADS
+    if (r != 0) {
+        PyErr_Format(PyExc_RuntimeError, "rtapi_app_main() returned %d "
+                     "(last HAL error: %s)", r, halsdk_api_ptr->last_error());
+        return NULL;
+    }
+    Py_RETURN_NONE;
+}
+
+static PyObject *mod_cleanup(PyObject *self, PyObject *unused)
+{
+    if (rtapi_app_exit) {
+        Py_BEGIN_ALLOW_THREADS
+        rtapi_app_exit();
+        Py_END_ALLOW_THREADS
+    }
+    Py_RETURN_NONE;
+}
+
+static PyMethodDef methods[] = {
+    {"setup", (PyCFunction)(void (*)(void))mod_setup,
+     METH_VARARGS | METH_KEYWORDS,
+     "Set module parameters and run rtapi_app_main()."},
+    {"cleanup", mod_cleanup, METH_NOARGS, "Run rtapi_app_exit()."},
+    {NULL, NULL, 0, NULL}
+};
+
+static struct PyModuleDef module = {
+    PyModuleDef_HEAD_INIT, STR_(HALSDK_MODULE_NAME),
+    "HAL component written in C", -1, methods,
+    NULL, NULL, NULL, NULL
+};
+
+PyMODINIT_FUNC CAT_(PyInit_, HALSDK_MODULE_NAME)(void)
+{
+    if (import_halsdk() < 0)
+        return NULL;
+    if (mp_overflow) {
+        PyErr_Format(PyExc_ImportError, "%s declares more than %d module "
+                     "parameters", STR_(HALSDK_MODULE_NAME),
+                     HALSDK_MAX_MODPARAMS);
+        return NULL;
+    }
+    if (save_defaults() < 0)
+        return PyErr_NoMemory();
+    PyObject *m = PyModule_Create(&module);
+    if (!m)
+        return NULL;
+    PyObject *mp = PyDict_New();
+    for (int i = 0; mp && i < nmodparams; i++) {
+        halsdk_modparam_t *p = &modparams[i];
+        PyObject *cur = current_value(p);
+        PyObject *t = cur ? Py_BuildValue("(C N s)", p->kind, cur,
+                                          p->desc ? p->desc : "") : NULL;
+        if (!t || PyDict_SetItemString(mp, p->name, t) < 0) {
+            Py_XDECREF(t);
+            Py_CLEAR(mp);
+            break;
+        }
+        Py_DECREF(t);
+    }
+    if (!mp || PyModule_AddObject(m, "modparams", mp) < 0) {
+        Py_XDECREF(mp);
+        Py_DECREF(m);
+        return NULL;
+    }
+    return m;
+}

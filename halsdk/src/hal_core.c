@@ -1,0 +1,1648 @@
+/*
+ * hal_core.c - the halsdk instance: shared memory, allocator, name index
+ * and the rules for components, pins, params, signals and functions.
+ *
+ * Every operation that changes metadata takes the instance mutex, checks
+ * all of its rules before it changes anything, and reports a violation as
+ * -errno with a message naming the object (hal_last_error()).  Realtime
+ * threads never take the mutex.
+ */
+#define _GNU_SOURCE
+#include "hal_core.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <fnmatch.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <signal.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+hal_map_t hal_map;
+static __thread char errbuf[512];
+static int cur_owner;           /* last comp/inst created here: hal_malloc */
+
+int hal_fail(int err, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(errbuf, sizeof(errbuf), fmt, ap);
+    va_end(ap);
+    return err > 0 ? -err : err;
+}
+
+const char *hal_last_error(void)
+{
+    return errbuf;
+}
+
+static const char *kind_word(int kind)
+{
+    static const char *const words[K_NKINDS] = {
+        "object", "component", "instance", "pin", "param", "signal",
+        "function", "thread"
+    };
+    return kind > 0 && kind < K_NKINDS ? words[kind] : "object";
+}
+
+/* ---------------------------------------------------------------- */
+/* process identity                                                 */
+
+uint64_t hal_proc_start_time(int pid)
+{
+    char path[64], buf[1024];
+    snprintf(path, sizeof(path), "/proc/%d/stat", pid);
+    int fd = open(path, O_RDONLY);
+    if (fd < 0)
+        return 0;
+    ssize_t n = read(fd, buf, sizeof(buf) - 1);
+    close(fd);
+    if (n <= 0)
+        return 0;
+    buf[n] = 0;
+    /* field 22 (starttime); the command name may hold spaces */
+    char *p = strrchr(buf, ')');
+    if (!p)
+        return 0;
+    int field = 2;
+    for (; *p && field < 22; p++)
+        if (*p == ' ')
+            field++;
+    return strtoull(p, NULL, 10);
+}
+
+int hal_pid_alive(int pid, uint64_t start)
+{
+    if (pid <= 0)
+        return 0;
+    if (kill(pid, 0) != 0 && errno == ESRCH)
+        return 0;
+    uint64_t now = hal_proc_start_time(pid);
+    if (now == 0)
+        return 0;
+    /* a zombie still has /proc entries: treat it as gone */
+    char path[64], buf[512];
+    snprintf(path, sizeof(path), "/proc/%d/stat", pid);
+    int fd = open(path, O_RDONLY);
+    if (fd >= 0) {
+        ssize_t n = read(fd, buf, sizeof(buf) - 1);
+        close(fd);
+        if (n > 0) {
+            buf[n] = 0;
+            char *p = strrchr(buf, ')');
+            if (p && p[1] == ' ' && (p[2] == 'Z' || p[2] == 'X'))
+                return 0;
+        }
+    }
+    return start == 0 || now == start;
+}
+
+/* ---------------------------------------------------------------- */
+/* mutex                                                            */
+
+static void recover_after_dead_holder(void);
+
+int hal_lock(void)
+{
+    hal_header_t *h = hal_map.hdr;
+    if (!h)
+        return hal_fail(ENODEV, "no HAL instance is attached");
+    int r = pthread_mutex_lock(&h->mutex);
+    if (r == EOWNERDEAD) {
+        recover_after_dead_holder();
+        pthread_mutex_consistent(&h->mutex);
+        h->recovered++;
+        return 0;
+    }
+    if (r)
+        return hal_fail(r, "cannot lock the HAL instance: %s", strerror(r));
+    return 0;
+}
+
+void hal_unlock(void)
+{
+    if (hal_map.hdr)
+        pthread_mutex_unlock(&hal_map.hdr->mutex);
+}
+
+/* test hook: hold the lock so that a test can kill the holder */
+int hal_hold_lock_for_test(double seconds)
+{
+    int r = hal_lock();
+    if (r)
+        return r;
+    struct timespec ts = {(time_t)seconds,
+                          (long)((seconds - (long)seconds) * 1e9)};
+    nanosleep(&ts, NULL);
+    hal_unlock();
+    return 0;
+}
+
+/* ---------------------------------------------------------------- */
+/* allocator                                                        */
+
+static inline uint32_t round16(long n)
+{
+    return (uint32_t)((n + 15) & ~15L);
+}
+
+void *hal_alloc(long size, hoff_t owner)
+{
+    hal_header_t *h = hal_map.hdr;
+    if (size <= 0 || size > (long)(h->heap_end - h->heap_start))
+        return NULL;
+    uint32_t need = round16(size);
+    hal_block_t *b = NULL;
+    uint32_t cls = need / 16;
+    if (cls < HAL_NCLASSES && h->free_class[cls]) {
+        b = SHMPTR(h->free_class[cls]);
+        h->free_class[cls] = b->next;
+    } else if (cls >= HAL_NCLASSES) {
+        /* first fit among the big free blocks */
+        hoff_t *link = &h->free_big;
+        while (*link) {
+            hal_block_t *c = SHMPTR(*link);
+            if (c->size >= need) {
+                *link = c->next;
+                b = c;
+                break;
+            }
+            link = &c->next;
+        }
+    }
+    if (!b) {
+        uint64_t total = sizeof(hal_block_t) + need;
+        if ((uint64_t)h->heap_top + total > h->heap_end)
+            return NULL;
+        b = SHMPTR(h->heap_top);
+        h->heap_top += (hoff_t)total;
+        b->size = need;
+    }
+    b->magic = HAL_BLOCK_USED;
+    b->owner = owner;
+    b->next = 0;
+    h->bytes_used += sizeof(hal_block_t) + b->size;
+    void *p = b + 1;
+    memset(p, 0, b->size);
+    return p;
+}
+
+void hal_free(void *p)
+{
+    hal_header_t *h = hal_map.hdr;
+    if (!p)
+        return;
+    hal_block_t *b = (hal_block_t *)p - 1;
+    if (b->magic != HAL_BLOCK_USED)
+        return;
+    b->magic = HAL_BLOCK_FREE;
+    h->bytes_used -= sizeof(hal_block_t) + b->size;
+    uint32_t cls = b->size / 16;
+    if (cls < HAL_NCLASSES) {
+        b->next = h->free_class[cls];
+        h->free_class[cls] = SHMOFF(b);
+    } else {
+        b->next = h->free_big;
+        h->free_big = SHMOFF(b);
+    }
+}
+
+/* memory that a component asked for: chained to its owner */
+static void *alloc_for(hoff_t owner_off, long size)
+{
+    void *p = hal_alloc(size, owner_off);
+    if (!p || !owner_off)
+        return p;
+    hal_block_t *b = (hal_block_t *)p - 1;
+    hal_obj_t *o = SHMPTR(owner_off);
+    hoff_t *head = o->kind == K_COMP ? &((hal_comp_t *)o)->mem
+                                     : &((hal_inst_t *)o)->mem;
+    b->next = *head;
+    *head = SHMOFF(b);
+    return p;
+}
+
+static void free_owned(hoff_t *head)
+{
+    while (*head) {
+        hal_block_t *b = SHMPTR(*head);
+        *head = b->next;
+        hal_free(b + 1);
+    }
+}
+
+/* ---------------------------------------------------------------- */
+/* name index                                                       */
+
+static int name_space(int kind)
+{
+    if (kind == K_PARAM)
+        return K_PIN;
+    if (kind == K_INST)
+        return K_COMP;
+    return kind;
+}
+
+static uint32_t name_hash(int space, const char *name)
+{
+    uint32_t x = 2166136261u ^ (uint32_t)space;
+    for (const unsigned char *p = (const unsigned char *)name; *p; p++) {
+        x ^= *p;
+        x *= 16777619u;
+    }
+    return x;
+}
+
+static hoff_t *bucket(uint32_t hash)
+{
+    hal_header_t *h = hal_map.hdr;
+    hoff_t *b = SHMPTR(h->buckets);
+    return &b[hash & (h->nbuckets - 1)];
+}
+
+static void *find_in_space(int space, const char *name)
+{
+    uint32_t x = name_hash(space, name);
+    for (hoff_t o = *bucket(x); o;) {
+        hal_obj_t *obj = SHMPTR(o);
+        if (obj->hash == x && name_space(obj->kind) == space &&
+            strcmp(obj->name, name) == 0)
+            return obj;
+        o = obj->hnext;
+    }
+    return NULL;
+}
+
+void *hal_find(int kind, const char *name)
+{
+    hal_obj_t *o = find_in_space(name_space(kind), name);
+    return o && o->kind == kind ? o : NULL;
+}
+
+static void index_insert(hal_obj_t *o)
+{
+    o->hash = name_hash(name_space(o->kind), o->name);
+    hoff_t *b = bucket(o->hash);
+    o->hnext = *b;
+    *b = SHMOFF(o);
+}
+
+static void index_remove(hal_obj_t *o)
+{
+    hoff_t *link = bucket(o->hash), me = SHMOFF(o);
+    while (*link) {
+        if (*link == me) {
+            *link = o->hnext;
+            break;
+        }
+        link = &((hal_obj_t *)SHMPTR(*link))->hnext;
+    }
+    o->hnext = 0;
+}
+
+int hal_check_name(const char *name, const char *what)
+{
+    if (!name || !*name)
+        return hal_fail(EINVAL, "%s name is empty", what);
+    size_t n = strnlen(name, HAL_NAME_SIZE);
+    if (n > HALSDK_NAME_LEN)
+        return hal_fail(EINVAL, "%s name '%.*s...' is longer than %d "
+                        "characters", what, 40, name, HALSDK_NAME_LEN);
+    for (const unsigned char *p = (const unsigned char *)name; *p; p++) {
+        if (*p <= ' ' || *p >= 127 || *p == '"' || *p == '\'' ||
+            *p == '#' || *p == '\\' || *p == '$' || *p == '[' || *p == ']')
+            return hal_fail(EINVAL, "%s name '%s' contains the character "
+                            "'%s' (allowed: printable ASCII without "
+                            "blanks, quotes, #, $, [, ] or \\)", what,
+                            name, *p <= ' ' || *p >= 127 ? "non-printable"
+                            : (char[]){(char)*p, 0});
+    }
+    if (name[0] == '.' || name[n - 1] == '.' || strstr(name, ".."))
+        return hal_fail(EINVAL, "%s name '%s' has an empty level "
+                        "(leading, trailing or doubled '.')", what, name);
+    return 0;
+}
+
+/* ---------------------------------------------------------------- */
+/* object records                                                   */
+
+static void *obj_new(int kind, long size, const char *name)
+{
+    hal_header_t *h = hal_map.hdr;
+    hal_obj_t *o = hal_alloc(size, 0);
+    if (!o) {
+        hal_fail(ENOMEM, "HAL instance is full: cannot create %s '%s' "
+                 "(%llu of %llu bytes used; create the instance with a "
+                 "larger size)", kind_word(kind), name,
+                 (unsigned long long)h->bytes_used,
+                 (unsigned long long)h->size);
+        return NULL;
+    }
+    o->kind = (uint16_t)kind;
+    o->gen = ++h->next_gen;
+    snprintf(o->name, sizeof(o->name), "%s", name);
+    return o;
+}
+
+/* make a filled record visible: list, index, count */
+static void obj_publish(hal_obj_t *o)
+{
+    hal_header_t *h = hal_map.hdr;
+    hoff_t me = SHMOFF(o);
+    o->next = 0;
+    o->prev = h->list_tail[o->kind];
+    if (o->prev)
+        ((hal_obj_t *)SHMPTR(o->prev))->next = me;
+    else
+        h->list_head[o->kind] = me;
+    h->list_tail[o->kind] = me;
+    index_insert(o);
+    h->count[o->kind]++;
+    h->serial++;
+}
+
+static void obj_delete(hal_obj_t *o)
+{
+    hal_header_t *h = hal_map.hdr;
+    index_remove(o);
+    if (o->prev)
+        ((hal_obj_t *)SHMPTR(o->prev))->next = o->next;
+    else
+        h->list_head[o->kind] = o->next;
+    if (o->next)
+        ((hal_obj_t *)SHMPTR(o->next))->prev = o->prev;
+    else
+        h->list_tail[o->kind] = o->prev;
+    h->count[o->kind]--;
+    h->serial++;
+    o->kind = K_NONE;
+    o->gen = 0;         /* stale handles see the record is gone */
+    hal_free(o);
+}
+
+#define FOR_EACH(kind, type, var)                                         \
+    for (type *var = hal_map.hdr->list_head[kind]                         \
+                         ? SHMPTR(hal_map.hdr->list_head[kind]) : NULL,   \
+              *var##_nx = NULL;                                           \
+         var && ((var##_nx = var->o.next ? SHMPTR(var->o.next) : NULL),   \
+                 1);                                                      \
+         var = var##_nx)
+
+hal_comp_t *hal_comp_by_id(int id)
+{
+    FOR_EACH(K_COMP, hal_comp_t, c)
+        if (c->id == id)
+            return c;
+    return NULL;
+}
+
+hal_inst_t *hal_inst_by_id(int id)
+{
+    FOR_EACH(K_INST, hal_inst_t, i)
+        if (i->id == id)
+            return i;
+    return NULL;
+}
+
+/* owner of a new item: a comp or an inst id of this process */
+static int resolve_owner(int id, hal_comp_t **comp, hal_inst_t **inst,
+                         const char *what, const char *name)
+{
+    *inst = NULL;
+    *comp = hal_comp_by_id(id);
+    if (!*comp) {
+        *inst = hal_inst_by_id(id);
+        if (*inst)
+            *comp = SHMPTR((*inst)->comp);
+    }
+    if (!*comp)
+        return hal_fail(EINVAL, "%s '%s': no component with id %d", what,
+                        name, id);
+    if ((*comp)->pid != getpid())
+        return hal_fail(EPERM, "%s '%s': component '%s' belongs to "
+                        "process %d", what, name, (*comp)->o.name,
+                        (*comp)->pid);
+    if ((*comp)->ready && !*inst)
+        return hal_fail(EINVAL, "%s '%s': component '%s' is already "
+                        "ready; items are created before hal_ready()",
+                        what, name, (*comp)->o.name);
+    return 0;
+}
+
+static int in_segment(const volatile void *p, long len)
+{
+    const char *c = (const char *)p;
+    return c >= hal_map.base + sizeof(hal_header_t) &&
+           c + len <= hal_map.base + hal_map.size;
+}
+
+static long type_size(int type)
+{
+    switch (type) {
+    case HALSDK_BIT: return 1;
+    case HALSDK_FLOAT: return 8;
+    case HALSDK_S32: case HALSDK_U32: return 4;
+    case HALSDK_S64: case HALSDK_U64: return 8;
+    }
+    return 0;
+}
+
+static const char *type_word(int type)
+{
+    switch (type) {
+    case HALSDK_BIT: return "bit";
+    case HALSDK_FLOAT: return "float";
+    case HALSDK_S32: return "s32";
+    case HALSDK_U32: return "u32";
+    case HALSDK_S64: return "s64";
+    case HALSDK_U64: return "u64";
+    }
+    return "unknown";
+}
+
+/* ---------------------------------------------------------------- */
+/* components and instances                                         */
+
+int hal_comp_new(const char *name, int kind)
+{
+    int r = hal_check_name(name, "component");
+    if (r)
+        return r;
+    if (kind != HALSDK_COMP_USER && kind != HALSDK_COMP_RT)
+        return hal_fail(EINVAL, "component '%s': bad kind %d", name, kind);
+    if ((r = hal_lock()))
+        return r;
+    hal_header_t *h = hal_map.hdr;
+    if (kind == HALSDK_COMP_RT && (h->lock & HAL_LOCK_LOAD)) {
+        hal_unlock();
+        return hal_fail(EPERM, "component '%s': HAL is locked against "
+                        "loading", name);
+    }
+    if (find_in_space(K_COMP, name)) {
+        hal_unlock();
+        return hal_fail(EEXIST, "duplicate component name '%s'", name);
+    }
+    hal_comp_t *c = obj_new(K_COMP, sizeof(*c), name);
+    if (!c) {
+        hal_unlock();
+        return -ENOMEM;
+    }
+    c->id = h->next_id++;
+    c->kind = kind;
+    c->pid = getpid();
+    c->pid_start = hal_proc_start_time(c->pid);
+    c->base = (uint64_t)(uintptr_t)hal_map.base;
+    obj_publish(&c->o);
+    cur_owner = c->id;
+    hal_unlock();
+    return c->id;
+}
+
+int hal_comp_set_ready(int id, int ready)
+{
+    int r = hal_lock();
+    if (r)
+        return r;
+    hal_comp_t *c = hal_comp_by_id(id);
+    if (!c) {
+        hal_unlock();
+        return hal_fail(EINVAL, "no component with id %d", id);
+    }
+    c->ready = ready;
+    hal_map.hdr->serial++;
+    hal_unlock();
+    return 0;
+}
+
+int hal_inst_new(const char *name, int comp_id)
+{
+    int r = hal_check_name(name, "instance");
+    if (r)
+        return r;
+    if ((r = hal_lock()))
+        return r;
+    hal_comp_t *c = hal_comp_by_id(comp_id);
+    if (!c)
+        r = hal_fail(EINVAL, "instance '%s': no component with id %d",
+                     name, comp_id);
+    else if (c->pid != getpid())
+        r = hal_fail(EPERM, "instance '%s': component '%s' belongs to "
+                     "process %d", name, c->o.name, c->pid);
+    else if (find_in_space(K_COMP, name))
+        r = hal_fail(EEXIST, "duplicate instance name '%s'", name);
+    if (r) {
+        hal_unlock();
+        return r;
+    }
+    hal_inst_t *i = obj_new(K_INST, sizeof(*i), name);
+    if (!i) {
+        hal_unlock();
+        return -ENOMEM;
+    }
+    i->id = hal_map.hdr->next_id++;
+    i->comp = SHMOFF(c);
+    c->ninst++;
+    obj_publish(&i->o);
+    cur_owner = i->id;
+    hal_unlock();
+    return i->id;
+}
+
+void *hal_malloc_owned(long size, int owner_id)
+{
+    if (hal_lock())
+        return NULL;
+    hoff_t owner = 0;
+    hal_comp_t *c = hal_comp_by_id(owner_id);
+    hal_inst_t *i = c ? NULL : hal_inst_by_id(owner_id);
+    if (c && c->pid == getpid())
+        owner = SHMOFF(c);
+    else if (i && ((hal_comp_t *)SHMPTR(i->comp))->pid == getpid())
+        owner = SHMOFF(i);
+    void *p = alloc_for(owner, size);
+    if (!p)
+        hal_fail(ENOMEM, "hal_malloc(%ld): HAL instance is full", size);
+    hal_unlock();
+    return p;
+}
+
+/* hal_malloc() has no owner argument: the memory goes to the component
+   or instance this process created last */
+void *hal_malloc_current(long size)
+{
+    return hal_malloc_owned(size, cur_owner);
+}
+
+/* ---------------------------------------------------------------- */
+/* pins and params                                                  */
+
+static void write_cell(hal_pin_t *pin, volatile void *target)
+{
+    hal_comp_t *c = SHMPTR(pin->comp);
+    uint64_t addr = c->base + (uint64_t)((const char *)target - hal_map.base);
+    __atomic_store_n((uint64_t *)SHMPTR(pin->ptr_cell), addr,
+                     __ATOMIC_RELEASE);
+}
+
+hal_value_t *hal_pin_value(hal_pin_t *pin)
+{
+    if (pin->signal)
+        return &((hal_sig_t *)SHMPTR(pin->signal))->value;
+    return &pin->dummy;
+}
+
+void *hal_param_value(hal_param_t *param)
+{
+    return SHMPTR(param->data);
+}
+
+int hal_pin_new(const char *name, int type, int dir, void **ptr_cell,
+                int owner_id)
+{
+    int r = hal_check_name(name, "pin");
+    if (r)
+        return r;
+    if (!type_size(type))
+        return hal_fail(EINVAL, "pin '%s': bad type %d", name, type);
+    if (dir != HALSDK_IN && dir != HALSDK_OUT && dir != HALSDK_IO)
+        return hal_fail(EINVAL, "pin '%s': bad direction %d", name, dir);
+    if (!hal_map.hdr)
+        return hal_fail(ENODEV, "no HAL instance is attached");
+    if (!in_segment(ptr_cell, sizeof(void *)))
+        return hal_fail(EINVAL, "pin '%s': data_ptr_addr is not in HAL "
+                        "shared memory (allocate it with hal_malloc)",
+                        name);
+    if ((r = hal_lock()))
+        return r;
+    hal_comp_t *c;
+    hal_inst_t *i;
+    if ((r = resolve_owner(owner_id, &c, &i, "pin", name)))
+        goto out;
+    if (find_in_space(K_PIN, name)) {
+        r = hal_fail(EEXIST, "duplicate pin or param name '%s'", name);
+        goto out;
+    }
+    hal_pin_t *p = obj_new(K_PIN, sizeof(*p), name);
+    if (!p) {
+        r = -ENOMEM;
+        goto out;
+    }
+    p->type = (int16_t)type;
+    p->dir = (int16_t)dir;
+    p->comp = SHMOFF(c);
+    p->inst = i ? SHMOFF(i) : 0;
+    p->ptr_cell = SHMOFF(ptr_cell);
+    write_cell(p, &p->dummy);
+    obj_publish(&p->o);
+out:
+    hal_unlock();
+    return r;
+}
+
+int hal_param_new(const char *name, int type, int dir, volatile void *data,
+                  int owner_id)
+{
+    int r = hal_check_name(name, "param");
+    if (r)
+        return r;
+    if (!type_size(type))
+        return hal_fail(EINVAL, "param '%s': bad type %d", name, type);
+    if (dir != HALSDK_RO && dir != HALSDK_RW)
+        return hal_fail(EINVAL, "param '%s': bad direction %d", name, dir);
+    if (!hal_map.hdr)
+        return hal_fail(ENODEV, "no HAL instance is attached");
+    if (!in_segment(data, type_size(type)))
+        return hal_fail(EINVAL, "param '%s': data_addr is not in HAL "
+                        "shared memory (allocate it with hal_malloc)",
+                        name);
+    if ((r = hal_lock()))
+        return r;
+    hal_comp_t *c;
+    hal_inst_t *i;
+    if ((r = resolve_owner(owner_id, &c, &i, "param", name)))
+        goto out;
+    if (find_in_space(K_PIN, name)) {
+        r = hal_fail(EEXIST, "duplicate pin or param name '%s'", name);
+        goto out;
+    }
+    hal_param_t *p = obj_new(K_PARAM, sizeof(*p), name);
+    if (!p) {
+        r = -ENOMEM;
+        goto out;
+    }
+    p->type = (int16_t)type;
+    p->dir = (int16_t)dir;
+    p->comp = SHMOFF(c);
+    p->inst = i ? SHMOFF(i) : 0;
+    p->data = SHMOFF(data);
+    obj_publish(&p->o);
+out:
+    hal_unlock();
+    return r;
+}
+
+/* rename a pin or param; its original name is kept for unalias */
+static int rename_item(hal_obj_t *o, hoff_t *oldname, const char *alias)
+{
+    if (!*oldname) {
+        char *keep = hal_alloc(HAL_NAME_SIZE, 0);
+        if (!keep)
+            return hal_fail(ENOMEM, "HAL instance is full: cannot alias "
+                            "'%s'", o->name);
+        memcpy(keep, o->name, HAL_NAME_SIZE);
+        *oldname = SHMOFF(keep);
+    }
+    index_remove(o);
+    snprintf(o->name, sizeof(o->name), "%s", alias);
+    index_insert(o);
+    hal_map.hdr->serial++;
+    return 0;
+}
+
+int hal_alias(int kind, const char *name, const char *alias)
+{
+    int r = hal_check_name(alias, "alias");
+    if (r)
+        return r;
+    if ((r = hal_lock()))
+        return r;
+    hal_obj_t *o = hal_find(kind, name);
+    hoff_t *oldname = NULL;
+    if (!o) {
+        r = hal_fail(ENOENT, "%s '%s' not found", kind_word(kind), name);
+        goto out;
+    }
+    oldname = kind == K_PIN ? &((hal_pin_t *)o)->oldname
+                            : &((hal_param_t *)o)->oldname;
+    if (find_in_space(K_PIN, alias)) {
+        r = hal_fail(EEXIST, "duplicate pin or param name '%s'", alias);
+        goto out;
+    }
+    r = rename_item(o, oldname, alias);
+out:
+    hal_unlock();
+    return r;
+}
+
+int hal_unalias(int kind, const char *alias)
+{
+    int r = hal_lock();
+    if (r)
+        return r;
+    hal_obj_t *o = hal_find(kind, alias);
+    hoff_t *oldname;
+    if (!o) {
+        r = hal_fail(ENOENT, "%s '%s' not found", kind_word(kind), alias);
+        goto out;
+    }
+    oldname = kind == K_PIN ? &((hal_pin_t *)o)->oldname
+                            : &((hal_param_t *)o)->oldname;
+    if (!*oldname)
+        goto out;           /* not aliased: nothing to do */
+    char *orig = SHMPTR(*oldname);
+    if (find_in_space(K_PIN, orig)) {
+        r = hal_fail(EEXIST, "cannot unalias '%s': its original name '%s' "
+                     "is in use", alias, orig);
+        goto out;
+    }
+    index_remove(o);
+    memcpy(o->name, orig, HAL_NAME_SIZE);
+    index_insert(o);
+    hal_free(orig);
+    *oldname = 0;
+    hal_map.hdr->serial++;
+out:
+    hal_unlock();
+    return r;
+}
+
+/* ---------------------------------------------------------------- */
+/* signals and links                                                */
+
+int hal_signal_new(const char *name, int type)
+{
+    int r = hal_check_name(name, "signal");
+    if (r)
+        return r;
+    if (!type_size(type))
+        return hal_fail(EINVAL, "signal '%s': bad type %d", name, type);
+    if ((r = hal_lock()))
+        return r;
+    if (hal_map.hdr->lock & HAL_LOCK_CONFIG)
+        r = hal_fail(EPERM, "signal '%s': HAL is locked against "
+                     "configuration", name);
+    else if (find_in_space(K_SIG, name))
+        r = hal_fail(EEXIST, "duplicate signal name '%s'", name);
+    if (!r) {
+        hal_sig_t *s = obj_new(K_SIG, sizeof(*s), name);
+        if (s) {
+            s->type = (int16_t)type;
+            obj_publish(&s->o);
+        } else {
+            r = -ENOMEM;
+        }
+    }
+    hal_unlock();
+    return r;
+}
+
+static void unlink_locked(hal_pin_t *p)
+{
+    hal_sig_t *s = SHMPTR(p->signal);
+    /* the pin keeps the last value it saw */
+    p->dummy.lu = s->value.lu;
+    write_cell(p, &p->dummy);
+    p->signal = 0;
+    if (p->dir == HALSDK_IN)
+        s->readers--;
+    else if (p->dir == HALSDK_OUT)
+        s->writers--;
+    else
+        s->bidirs--;
+    hal_map.hdr->serial++;
+}
+
+int hal_signal_delete(const char *name)
+{
+    int r = hal_lock();
+    if (r)
+        return r;
+    hal_sig_t *s = hal_find(K_SIG, name);
+    if (!s)
+        r = hal_fail(ENOENT, "signal '%s' not found", name);
+    else if (hal_map.hdr->lock & HAL_LOCK_CONFIG)
+        r = hal_fail(EPERM, "signal '%s': HAL is locked against "
+                     "configuration", name);
+    if (!r) {
+        hoff_t so = SHMOFF(s);
+        FOR_EACH(K_PIN, hal_pin_t, p)
+            if (p->signal == so)
+                unlink_locked(p);
+        obj_delete(&s->o);
+    }
+    hal_unlock();
+    return r;
+}
+
+int hal_link(const char *pin_name, const char *sig_name)
+{
+    int r = hal_lock();
+    if (r)
+        return r;
+    hal_pin_t *p = hal_find(K_PIN, pin_name);
+    hal_sig_t *s = hal_find(K_SIG, sig_name);
+    if (hal_map.hdr->lock & HAL_LOCK_CONFIG)
+        r = hal_fail(EPERM, "cannot link '%s': HAL is locked against "
+                     "configuration", pin_name);
+    else if (!p)
+        r = hal_fail(ENOENT, "pin '%s' not found", pin_name);
+    else if (!s)
+        r = hal_fail(ENOENT, "signal '%s' not found", sig_name);
+    else if (p->signal == SHMOFF(s))
+        goto out;           /* already there */
+    else if (p->signal)
+        r = hal_fail(EBUSY, "Pin '%s' was already linked to signal '%s'",
+                     pin_name, ((hal_sig_t *)SHMPTR(p->signal))->o.name);
+    else if (p->type != s->type)
+        r = hal_fail(EPROTOTYPE, "Signal '%s' of type '%s' cannot add pin "
+                     "'%s' of type '%s'", sig_name, type_word(s->type),
+                     pin_name, type_word(p->type));
+    else if (p->dir == HALSDK_OUT && s->writers > 0)
+        r = hal_fail(EBUSY, "signal '%s' already has an output pin, "
+                     "cannot add output pin '%s'", sig_name, pin_name);
+    else if (p->dir == HALSDK_OUT && s->bidirs > 0)
+        r = hal_fail(EBUSY, "signal '%s' has I/O pins, cannot add output "
+                     "pin '%s'", sig_name, pin_name);
+    else if (p->dir == HALSDK_IO && s->writers > 0)
+        r = hal_fail(EBUSY, "signal '%s' has an output pin, cannot add "
+                     "I/O pin '%s'", sig_name, pin_name);
+    if (r)
+        goto out;
+    /* the first pin of a signal gives the signal its value */
+    if (s->readers == 0 && s->writers == 0 && s->bidirs == 0)
+        s->value.lu = p->dummy.lu;
+    if (p->dir == HALSDK_IN)
+        s->readers++;
+    else if (p->dir == HALSDK_OUT)
+        s->writers++;
+    else
+        s->bidirs++;
+    p->signal = SHMOFF(s);
+    write_cell(p, &s->value);
+    hal_map.hdr->serial++;
+out:
+    hal_unlock();
+    return r;
+}
+
+int hal_unlink(const char *pin_name)
+{
+    int r = hal_lock();
+    if (r)
+        return r;
+    hal_pin_t *p = hal_find(K_PIN, pin_name);
+    if (hal_map.hdr->lock & HAL_LOCK_CONFIG)
+        r = hal_fail(EPERM, "cannot unlink '%s': HAL is locked against "
+                     "configuration", pin_name);
+    else if (!p)
+        r = hal_fail(ENOENT, "pin '%s' not found", pin_name);
+    else if (p->signal)
+        unlink_locked(p);
+    hal_unlock();
+    return r;
+}
+
+/* ---------------------------------------------------------------- */
+/* functions and threads                                            */
+
+static hal_pin_t *item_pin_new(const char *name, int type, int dir,
+                               hal_comp_t *c, hal_inst_t *i, hoff_t owner)
+{
+    void **cell = alloc_for(owner, sizeof(void *));
+    hal_pin_t *p = cell ? obj_new(K_PIN, sizeof(*p), name) : NULL;
+    if (!p)
+        return NULL;
+    p->type = (int16_t)type;
+    p->dir = (int16_t)dir;
+    p->comp = SHMOFF(c);
+    p->inst = i ? SHMOFF(i) : 0;
+    p->ptr_cell = SHMOFF(cell);
+    write_cell(p, &p->dummy);
+    obj_publish(&p->o);
+    return p;
+}
+
+static hal_param_t *item_param_new(const char *name, int type, int dir,
+                                   hal_comp_t *c, hal_inst_t *i,
+                                   hoff_t owner)
+{
+    void *data = alloc_for(owner, 8);
+    hal_param_t *p = data ? obj_new(K_PARAM, sizeof(*p), name) : NULL;
+    if (!p)
+        return NULL;
+    p->type = (int16_t)type;
+    p->dir = (int16_t)dir;
+    p->comp = SHMOFF(c);
+    p->inst = i ? SHMOFF(i) : 0;
+    p->data = SHMOFF(data);
+    obj_publish(&p->o);
+    return p;
+}
+
+static int names_free(const char *base, const char *const *suffixes)
+{
+    char n[HAL_NAME_SIZE + 32];
+    for (; *suffixes; suffixes++) {
+        int len = snprintf(n, sizeof(n), "%s%s", base, *suffixes);
+        if (len > HALSDK_NAME_LEN)
+            return hal_fail(EINVAL, "name '%s' is longer than %d "
+                            "characters", n, HALSDK_NAME_LEN);
+        if (find_in_space(K_PIN, n))
+            return hal_fail(EEXIST, "duplicate pin or param name '%s'", n);
+    }
+    return 0;
+}
+
+int hal_export_funct(const char *name, halsdk_funct_t fn, void *arg,
+                     int uses_fp, int reentrant, int owner_id, int python)
+{
+    static const char *const sfx[] = {".time", ".tmax", ".tmax-increased",
+                                      NULL};
+    int r = hal_check_name(name, "function");
+    if (r)
+        return r;
+    if (!hal_map.hdr)
+        return hal_fail(ENODEV, "no HAL instance is attached");
+    if (!hal_map.is_host)
+        return hal_fail(EPERM, "function '%s': only components loaded in "
+                        "the host process (loadrt) export functions", name);
+    if (!fn)
+        return hal_fail(EINVAL, "function '%s': no entry point", name);
+    if ((r = hal_lock()))
+        return r;
+    hal_comp_t *c;
+    hal_inst_t *i;
+    if ((r = resolve_owner(owner_id, &c, &i, "function", name)))
+        goto out;
+    if (find_in_space(K_FUNCT, name)) {
+        r = hal_fail(EEXIST, "duplicate function name '%s'", name);
+        goto out;
+    }
+    if ((r = names_free(name, sfx)))
+        goto out;
+    hoff_t owner = i ? SHMOFF(i) : SHMOFF(c);
+    char n[HAL_NAME_SIZE + 32];
+    hal_funct_t *f = obj_new(K_FUNCT, sizeof(*f), name);
+    hal_pin_t *tp = NULL;
+    hal_param_t *tm = NULL, *ti = NULL;
+    if (f) {
+        snprintf(n, sizeof(n), "%s.time", name);
+        tp = item_pin_new(n, HALSDK_S32, HALSDK_OUT, c, i, owner);
+    }
+    if (tp) {
+        snprintf(n, sizeof(n), "%s.tmax", name);
+        tm = item_param_new(n, HALSDK_S32, HALSDK_RW, c, i, owner);
+    }
+    if (tm) {
+        snprintf(n, sizeof(n), "%s.tmax-increased", name);
+        ti = item_param_new(n, HALSDK_BIT, HALSDK_RO, c, i, owner);
+    }
+    if (!ti) {
+        /* undo what was made: the instance stays as it was */
+        if (tm)
+            obj_delete(&tm->o);
+        if (tp)
+            obj_delete(&tp->o);
+        if (f)
+            hal_free(f);
+        r = hal_fail(ENOMEM, "HAL instance is full: cannot export "
+                     "function '%s'", name);
+        goto out;
+    }
+    f->comp = SHMOFF(c);
+    f->inst = i ? SHMOFF(i) : 0;
+    f->uses_fp = uses_fp;
+    f->reentrant = reentrant;
+    f->python = python;
+    f->fn = (uint64_t)(uintptr_t)fn;
+    f->arg = (uint64_t)(uintptr_t)arg;
+    f->time_pin = SHMOFF(tp);
+    f->tmax_param = SHMOFF(tm);
+    f->tmax_inc_param = SHMOFF(ti);
+    obj_publish(&f->o);
+out:
+    hal_unlock();
+    return r;
+}
+
+int hal_thread_new(const char *name, long period, int uses_fp,
+                   unsigned timing_every)
+{
+    static const char *const sfx[] = {".time", ".tmax", NULL};
+    char n[HAL_NAME_SIZE + 32];
+    int r = hal_check_name(name, "thread");
+    if (r)
+        return r;
+    if (!hal_map.hdr)
+        return hal_fail(ENODEV, "no HAL instance is attached");
+    if (!hal_map.is_host)
+        return hal_fail(EPERM, "thread '%s': threads are created by the "
+                        "host process", name);
+    if (period < 1000)
+        return hal_fail(EINVAL, "thread '%s': period %ld ns is shorter "
+                        "than 1000 ns", name, period);
+    if (snprintf(n, sizeof(n), "__%s", name) > HALSDK_NAME_LEN)
+        return hal_fail(EINVAL, "thread name '%s' is too long", name);
+    if ((r = hal_lock()))
+        return r;
+    hal_header_t *h = hal_map.hdr;
+    if (find_in_space(K_THREAD, name))
+        r = hal_fail(EEXIST, "duplicate thread name '%s'", name);
+    else if (find_in_space(K_COMP, n))
+        r = hal_fail(EEXIST, "thread '%s': component name '%s' is taken",
+                     name, n);
+    else if (h->count[K_THREAD] >= HAL_MAX_THREADS)
+        r = hal_fail(ENOSPC, "thread '%s': at most %d threads",
+                     name, HAL_MAX_THREADS);
+    else
+        r = names_free(name, sfx);
+    if (r)
+        goto out;
+    hal_comp_t *c = obj_new(K_COMP, sizeof(*c), n);
+    hal_thread_t *t = c ? obj_new(K_THREAD, sizeof(*t), name) : NULL;
+    if (!t) {
+        if (c)
+            hal_free(c);
+        r = -ENOMEM;
+        goto out;
+    }
+    c->id = h->next_id++;
+    c->kind = HALSDK_COMP_RT;
+    c->ready = 1;
+    c->pid = getpid();
+    c->pid_start = hal_proc_start_time(c->pid);
+    c->base = (uint64_t)(uintptr_t)hal_map.base;
+    obj_publish(&c->o);
+    snprintf(n, sizeof(n), "%s.time", name);
+    hal_pin_t *tp = item_pin_new(n, HALSDK_S32, HALSDK_OUT, c, NULL,
+                                 SHMOFF(c));
+    snprintf(n, sizeof(n), "%s.tmax", name);
+    hal_param_t *tm = tp ? item_param_new(n, HALSDK_S32, HALSDK_RW, c, NULL,
+                                          SHMOFF(c)) : NULL;
+    if (!tm) {
+        if (tp)
+            obj_delete(&tp->o);
+        free_owned(&c->mem);
+        obj_delete(&c->o);
+        hal_free(t);
+        r = hal_fail(ENOMEM, "HAL instance is full: cannot create "
+                     "thread '%s'", name);
+        goto out;
+    }
+    t->period = period;
+    t->uses_fp = uses_fp;
+    t->timing_every = timing_every ? timing_every : 1;
+    t->comp = SHMOFF(c);
+    t->time_pin = SHMOFF(tp);
+    t->tmax_param = SHMOFF(tm);
+    /* faster threads get higher priority, as in the reference */
+    t->priority = 0;
+    int slot = exec_create(t);
+    if (slot < 0) {
+        obj_delete(&tm->o);
+        obj_delete(&tp->o);
+        free_owned(&c->mem);
+        obj_delete(&c->o);
+        hal_free(t);
+        r = slot;
+        goto out;
+    }
+    t->slot = slot;
+    obj_publish(&t->o);
+out:
+    hal_unlock();
+    return r;
+}
+
+/* remove every entry of a function from a thread's list */
+static int drop_entries(hal_thread_t *t, hoff_t fo)
+{
+    int n = 0;
+    hoff_t *link = &t->functs;
+    while (*link) {
+        hal_fentry_t *e = SHMPTR(*link);
+        if (fo == 0 || e->funct == fo) {
+            hal_funct_t *f = SHMPTR(e->funct);
+            f->users--;
+            *link = e->next;
+            hal_free(e);
+            t->nfuncts--;
+            n++;
+        } else {
+            link = &e->next;
+        }
+    }
+    return n;
+}
+
+static void thread_delete_locked(hal_thread_t *t)
+{
+    exec_destroy(t->slot);
+    drop_entries(t, 0);
+    hal_comp_t *c = SHMPTR(t->comp);
+    hoff_t co = t->comp;
+    FOR_EACH(K_PIN, hal_pin_t, p)
+        if (p->comp == co) {
+            if (p->signal)
+                unlink_locked(p);
+            obj_delete(&p->o);
+        }
+    FOR_EACH(K_PARAM, hal_param_t, p)
+        if (p->comp == co)
+            obj_delete(&p->o);
+    free_owned(&c->mem);
+    obj_delete(&c->o);
+    obj_delete(&t->o);
+}
+
+int hal_thread_delete(const char *name)
+{
+    int r = hal_lock();
+    if (r)
+        return r;
+    hal_thread_t *t = hal_find(K_THREAD, name);
+    if (!t)
+        r = hal_fail(ENOENT, "thread '%s' not found", name);
+    else if (!hal_map.is_host)
+        r = hal_fail(EPERM, "thread '%s': only the host deletes threads",
+                     name);
+    else if (exec_stepping())
+        r = hal_fail(EBUSY, "thread '%s' is being stepped", name);
+    else
+        thread_delete_locked(t);
+    hal_unlock();
+    return r;
+}
+
+int hal_addf(const char *funct, const char *thread, int position)
+{
+    int r = hal_lock();
+    if (r)
+        return r;
+    hal_funct_t *f = hal_find(K_FUNCT, funct);
+    hal_thread_t *t = hal_find(K_THREAD, thread);
+    if (hal_map.hdr->lock & HAL_LOCK_CONFIG)
+        r = hal_fail(EPERM, "addf '%s': HAL is locked against "
+                     "configuration", funct);
+    else if (!f)
+        r = hal_fail(ENOENT, "function '%s' not found", funct);
+    else if (!t)
+        r = hal_fail(ENOENT, "thread '%s' not found", thread);
+    else if (!hal_map.is_host)
+        r = hal_fail(EPERM, "addf '%s': only the host changes threads",
+                     funct);
+    else if (f->users > 0 && !f->reentrant)
+        r = hal_fail(EINVAL, "function '%s' may only be added to one "
+                     "thread", funct);
+    else if (f->uses_fp && !t->uses_fp)
+        r = hal_fail(EINVAL, "function '%s' needs FP, thread '%s' has no "
+                     "FP", funct, thread);
+    else if (position == 0 || position > t->nfuncts + 1 ||
+             position < -(t->nfuncts + 1))
+        r = hal_fail(EINVAL, "addf '%s': position %d is out of range for "
+                     "thread '%s' with %d functions", funct, position,
+                     thread, t->nfuncts);
+    if (r)
+        goto out;
+    hal_fentry_t *e = hal_alloc(sizeof(*e), 0);
+    if (!e) {
+        r = hal_fail(ENOMEM, "HAL instance is full: addf '%s'", funct);
+        goto out;
+    }
+    e->funct = SHMOFF(f);
+    int index = position > 0 ? position - 1 : t->nfuncts + 1 + position;
+    hoff_t *link = &t->functs;
+    for (int k = 0; k < index; k++)
+        link = &((hal_fentry_t *)SHMPTR(*link))->next;
+    e->next = *link;
+    *link = SHMOFF(e);
+    t->nfuncts++;
+    f->users++;
+    hal_map.hdr->serial++;
+    r = exec_publish(t);
+    if (r) {
+        *link = e->next;
+        hal_free(e);
+        t->nfuncts--;
+        f->users--;
+    }
+out:
+    hal_unlock();
+    return r;
+}
+
+int hal_delf(const char *funct, const char *thread)
+{
+    int r = hal_lock();
+    if (r)
+        return r;
+    hal_funct_t *f = hal_find(K_FUNCT, funct);
+    hal_thread_t *t = hal_find(K_THREAD, thread);
+    if (hal_map.hdr->lock & HAL_LOCK_CONFIG)
+        r = hal_fail(EPERM, "delf '%s': HAL is locked against "
+                     "configuration", funct);
+    else if (!f)
+        r = hal_fail(ENOENT, "function '%s' not found", funct);
+    else if (!t)
+        r = hal_fail(ENOENT, "thread '%s' not found", thread);
+    else if (!hal_map.is_host)
+        r = hal_fail(EPERM, "delf '%s': only the host changes threads",
+                     funct);
+    if (r)
+        goto out;
+    /* remove the first entry only, as the reference does */
+    hoff_t *link = &t->functs, fo = SHMOFF(f);
+    while (*link && ((hal_fentry_t *)SHMPTR(*link))->funct != fo)
+        link = &((hal_fentry_t *)SHMPTR(*link))->next;
+    if (!*link) {
+        r = hal_fail(ENOENT, "function '%s' is not in thread '%s'",
+                     funct, thread);
+        goto out;
+    }
+    hal_fentry_t *e = SHMPTR(*link);
+    *link = e->next;
+    t->nfuncts--;
+    f->users--;
+    hal_map.hdr->serial++;
+    exec_publish(t);    /* waits until no cycle uses the old list */
+    hal_free(e);
+out:
+    hal_unlock();
+    return r;
+}
+
+/* delete everything an owner (comp or inst) has; lock held */
+static void delete_items_of(hoff_t comp, hoff_t inst)
+{
+    /* functions first, out of every thread, before their memory goes */
+    FOR_EACH(K_FUNCT, hal_funct_t, f) {
+        if (f->comp != comp || (inst && f->inst != inst))
+            continue;
+        FOR_EACH(K_THREAD, hal_thread_t, t)
+            if (drop_entries(t, SHMOFF(f)))
+                exec_publish(t);
+    }
+    FOR_EACH(K_FUNCT, hal_funct_t, f)
+        if (f->comp == comp && (!inst || f->inst == inst))
+            obj_delete(&f->o);
+    FOR_EACH(K_PIN, hal_pin_t, p)
+        if (p->comp == comp && (!inst || p->inst == inst)) {
+            if (p->signal)
+                unlink_locked(p);
+            if (p->oldname)
+                hal_free(SHMPTR(p->oldname));
+            obj_delete(&p->o);
+        }
+    FOR_EACH(K_PARAM, hal_param_t, p)
+        if (p->comp == comp && (!inst || p->inst == inst)) {
+            if (p->oldname)
+                hal_free(SHMPTR(p->oldname));
+            obj_delete(&p->o);
+        }
+}
+
+int hal_inst_delete(const char *name)
+{
+    int r = hal_lock();
+    if (r)
+        return r;
+    hal_inst_t *i = hal_find(K_INST, name);
+    if (!i) {
+        hal_unlock();
+        return hal_fail(ENOENT, "instance '%s' not found", name);
+    }
+    hal_comp_t *c = SHMPTR(i->comp);
+    delete_items_of(i->comp, SHMOFF(i));
+    free_owned(&i->mem);
+    c->ninst--;
+    obj_delete(&i->o);
+    hal_unlock();
+    return 0;
+}
+
+int hal_comp_exit(int id)
+{
+    int r = hal_lock();
+    if (r)
+        return r;
+    hal_comp_t *c = hal_comp_by_id(id);
+    if (!c) {
+        hal_unlock();
+        return hal_fail(EINVAL, "no component with id %d", id);
+    }
+    hoff_t co = SHMOFF(c);
+    delete_items_of(co, 0);
+    FOR_EACH(K_INST, hal_inst_t, i)
+        if (i->comp == co) {
+            free_owned(&i->mem);
+            obj_delete(&i->o);
+        }
+    free_owned(&c->mem);
+    obj_delete(&c->o);
+    hal_unlock();
+    return 0;
+}
+
+int hal_set_lock(unsigned char lock)
+{
+    int r = hal_lock();
+    if (r)
+        return r;
+    hal_map.hdr->lock = lock;
+    hal_unlock();
+    return 0;
+}
+
+/* ---------------------------------------------------------------- */
+/* consistency                                                      */
+
+static int fsck_kind(int kind, char *rep, int len, int *bad)
+{
+    hal_header_t *h = hal_map.hdr;
+    int n = 0;
+    hoff_t prev = 0;
+    for (hoff_t o = h->list_head[kind]; o;) {
+        hal_obj_t *obj = SHMPTR(o);
+        if (o >= h->heap_top || obj->kind != kind || obj->prev != prev) {
+            snprintf(rep, len, "%s list broken at offset %u",
+                     kind_word(kind), o);
+            (*bad)++;
+            return n;
+        }
+        if (find_in_space(name_space(kind), obj->name) != obj) {
+            snprintf(rep, len, "%s '%s' is not in the name index",
+                     kind_word(kind), obj->name);
+            (*bad)++;
+        }
+        n++;
+        prev = o;
+        o = obj->next;
+    }
+    if (n != h->count[kind] || prev != h->list_tail[kind]) {
+        snprintf(rep, len, "%s count %d but %d listed", kind_word(kind),
+                 h->count[kind], n);
+        (*bad)++;
+    }
+    return n;
+}
+
+/* check the invariants; returns 0 when consistent */
+int hal_check_consistency(char *rep, int len)
+{
+    int bad = 0;
+    rep[0] = 0;
+    if (hal_lock())
+        return -1;
+    for (int k = 1; k < K_NKINDS; k++)
+        fsck_kind(k, rep, len, &bad);
+    FOR_EACH(K_SIG, hal_sig_t, s) {
+        int rd = 0, wr = 0, io = 0;
+        hoff_t so = SHMOFF(s);
+        FOR_EACH(K_PIN, hal_pin_t, p)
+            if (p->signal == so) {
+                rd += p->dir == HALSDK_IN;
+                wr += p->dir == HALSDK_OUT;
+                io += p->dir == HALSDK_IO;
+            }
+        if (rd != s->readers || wr != s->writers || io != s->bidirs ||
+            wr > 1 || (wr && io)) {
+            snprintf(rep, len, "signal '%s' link counts are wrong",
+                     s->o.name);
+            bad++;
+        }
+    }
+    FOR_EACH(K_PIN, hal_pin_t, p) {
+        hal_obj_t *c = SHMPTR(p->comp);
+        if (c->kind != K_COMP) {
+            snprintf(rep, len, "pin '%s' has no owner", p->o.name);
+            bad++;
+        }
+        if (p->signal && ((hal_obj_t *)SHMPTR(p->signal))->kind != K_SIG) {
+            snprintf(rep, len, "pin '%s' is linked to a deleted signal",
+                     p->o.name);
+            bad++;
+        }
+    }
+    FOR_EACH(K_FUNCT, hal_funct_t, f) {
+        int users = 0;
+        FOR_EACH(K_THREAD, hal_thread_t, t)
+            for (hoff_t e = t->functs; e;
+                 e = ((hal_fentry_t *)SHMPTR(e))->next)
+                users += ((hal_fentry_t *)SHMPTR(e))->funct == SHMOFF(f);
+        if (users != f->users) {
+            snprintf(rep, len, "function '%s' has %d users, %d counted",
+                     f->o.name, f->users, users);
+            bad++;
+        }
+    }
+    hal_unlock();
+    return bad;
+}
+
+/*
+ * A process died holding the lock.  Every operation publishes its object
+ * last, so the lists are whole; rebuild what can drift: the name index,
+ * the counts, the tail pointers and the link counts.
+ */
+static void recover_after_dead_holder(void)
+{
+    hal_header_t *h = hal_map.hdr;
+    memset(SHMPTR(h->buckets), 0, h->nbuckets * sizeof(hoff_t));
+    for (int k = 1; k < K_NKINDS; k++) {
+        hoff_t prev = 0;
+        int n = 0;
+        for (hoff_t o = h->list_head[k]; o;) {
+            hal_obj_t *obj = SHMPTR(o);
+            obj->prev = prev;
+            index_insert(obj);
+            prev = o;
+            n++;
+            o = obj->next;
+        }
+        h->list_tail[k] = prev;
+        h->count[k] = n;
+    }
+    FOR_EACH(K_SIG, hal_sig_t, s)
+        s->readers = s->writers = s->bidirs = 0;
+    FOR_EACH(K_PIN, hal_pin_t, p) {
+        if (!p->signal)
+            continue;
+        hal_sig_t *s = SHMPTR(p->signal);
+        if (s->o.kind != K_SIG) {
+            p->signal = 0;
+            write_cell(p, &p->dummy);
+            continue;
+        }
+        s->readers += p->dir == HALSDK_IN;
+        s->writers += p->dir == HALSDK_OUT;
+        s->bidirs += p->dir == HALSDK_IO;
+    }
+    h->serial++;
+}
+
+/* ---------------------------------------------------------------- */
+/* instance                                                         */
+
+int hal_instance_create(const char *shm_name, const char *instance,
+                        long size)
+{
+    if (hal_map.hdr)
+        return hal_fail(EBUSY, "this process already uses HAL instance "
+                        "'%s'", hal_map.hdr->instance);
+    if (size <= 0)
+        size = HAL_DEFAULT_SIZE;
+    if (size < HAL_MIN_SIZE || size > 0xF0000000L)
+        return hal_fail(EINVAL, "instance size %ld is out of range "
+                        "(%ld .. %ld bytes)", size, HAL_MIN_SIZE,
+                        0xF0000000L);
+    size = (size + 4095) & ~4095L;
+    int fd = shm_open(shm_name, O_RDWR | O_CREAT | O_EXCL, 0600);
+    if (fd < 0)
+        return hal_fail(errno, "cannot create HAL instance '%s' (%s): %s",
+                        instance, shm_name, strerror(errno));
+    fchmod(fd, 0600);
+    if (ftruncate(fd, size) < 0) {
+        int e = errno;
+        close(fd);
+        shm_unlink(shm_name);
+        return hal_fail(e, "cannot size HAL instance '%s': %s", instance,
+                        strerror(e));
+    }
+    char *base = mmap(NULL, size, PROT_READ | PROT_WRITE, MAP_SHARED, fd,
+                      0);
+    close(fd);
+    if (base == MAP_FAILED) {
+        int e = errno;
+        shm_unlink(shm_name);
+        return hal_fail(e, "cannot map HAL instance '%s': %s", instance,
+                        strerror(e));
+    }
+    hal_header_t *h = (hal_header_t *)base;
+    h->abi = HAL_ABI_VERSION;
+    h->header_size = sizeof(*h);
+    h->size = size;
+    snprintf(h->instance, sizeof(h->instance), "%s", instance);
+    pthread_mutexattr_t ma;
+    pthread_mutexattr_init(&ma);
+    pthread_mutexattr_setpshared(&ma, PTHREAD_PROCESS_SHARED);
+    pthread_mutexattr_setrobust(&ma, PTHREAD_MUTEX_ROBUST);
+    pthread_mutex_init(&h->mutex, &ma);
+    pthread_mutexattr_destroy(&ma);
+    h->host_pid = getpid();
+    h->host_start = hal_proc_start_time(h->host_pid);
+    h->host_base = (uint64_t)(uintptr_t)base;
+    h->next_id = 1;
+    h->msg_level = 1;
+    /* name index: about one bucket per 1 KiB of segment */
+    uint32_t nb = 1024;
+    while (nb < (uint64_t)size / 1024 && nb < (1u << 20))
+        nb <<= 1;
+    h->buckets = (hoff_t)((sizeof(*h) + 63) & ~63UL);
+    h->nbuckets = nb;
+    h->heap_start = (hoff_t)((h->buckets + nb * sizeof(hoff_t) + 63)
+                             & ~63UL);
+    h->heap_top = h->heap_start;
+    h->heap_end = (hoff_t)size;
+    hal_map.base = base;
+    hal_map.hdr = h;
+    hal_map.size = size;
+    hal_map.is_host = 1;
+    __atomic_store_n(&h->magic, HAL_MAGIC, __ATOMIC_RELEASE);
+    return 0;
+}
+
+int hal_instance_probe(const char *shm_name, int *host_pid,
+                       uint64_t *host_start, int *abi)
+{
+    int fd = shm_open(shm_name, O_RDONLY, 0);
+    if (fd < 0)
+        return -errno;
+    hal_header_t h;
+    ssize_t n = pread(fd, &h, sizeof(h), 0);
+    close(fd);
+    if (n < (ssize_t)offsetof(hal_header_t, mutex))
+        return -EPROTO;
+    if (h.magic != HAL_MAGIC)
+        return -EPROTO;
+    *host_pid = h.host_pid;
+    *host_start = h.host_start;
+    *abi = (int)h.abi;
+    return 0;
+}
+
+int hal_instance_attach(const char *shm_name)
+{
+    if (hal_map.hdr)
+        return hal_fail(EBUSY, "this process already uses HAL instance "
+                        "'%s'", hal_map.hdr->instance);
+    int fd = shm_open(shm_name, O_RDWR, 0);
+    if (fd < 0)
+        return hal_fail(errno, "no HAL instance at %s: %s", shm_name,
+                        strerror(errno));
+    struct stat st;
+    if (fstat(fd, &st) < 0 || st.st_size < (off_t)sizeof(hal_header_t)) {
+        close(fd);
+        return hal_fail(EPROTO, "%s is not a halsdk instance (too small)",
+                        shm_name);
+    }
+    char *base = mmap(NULL, st.st_size, PROT_READ | PROT_WRITE, MAP_SHARED,
+                      fd, 0);
+    close(fd);
+    if (base == MAP_FAILED)
+        return hal_fail(errno, "cannot map %s: %s", shm_name,
+                        strerror(errno));
+    hal_header_t *h = (hal_header_t *)base;
+    /* a creator writes the magic last: wait briefly for it */
+    for (int k = 0; k < 200 && __atomic_load_n(&h->magic, __ATOMIC_ACQUIRE)
+                                   != HAL_MAGIC; k++)
+        usleep(5000);
+    int r = 0;
+    if (h->magic != HAL_MAGIC)
+        r = hal_fail(EPROTO, "%s is not a halsdk instance (bad magic)",
+                     shm_name);
+    else if (h->abi != HAL_ABI_VERSION)
+        r = hal_fail(EPROTO, "HAL instance %s has ABI version %u; this "
+                     "halsdk speaks version %d", shm_name, h->abi,
+                     HAL_ABI_VERSION);
+    else if (h->size != (uint64_t)st.st_size)
+        r = hal_fail(EPROTO, "HAL instance %s: header size %llu does not "
+                     "match the segment (%lld bytes)", shm_name,
+                     (unsigned long long)h->size, (long long)st.st_size);
+    if (r) {
+        munmap(base, st.st_size);
+        return r;
+    }
+    hal_map.base = base;
+    hal_map.hdr = h;
+    hal_map.size = st.st_size;
+    hal_map.is_host = 0;
+    return 0;
+}
+
+void hal_instance_detach(int unlink_shm, const char *shm_name)
+{
+    if (!hal_map.hdr)
+        return;
+    munmap(hal_map.base, hal_map.size);
+    memset(&hal_map, 0, sizeof(hal_map));
+    cur_owner = 0;
+    if (unlink_shm && shm_name)
+        shm_unlink(shm_name);
+}
+
+/* ---------------------------------------------------------------- */
+/* time                                                             */
+
+long long hal_get_time(void)
+{
+    hal_header_t *h = hal_map.hdr;
+    if (h && h->sim_clock)
+        return h->sim_time;
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (long long)ts.tv_sec * 1000000000LL + ts.tv_nsec;
+}
+
+long long hal_get_clocks(void)
+{
+#if defined(__x86_64__) || defined(__i386__)
+    return (long long)__builtin_ia32_rdtsc();
+#else
+    return hal_get_time();
+#endif
+}

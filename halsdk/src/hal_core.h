@@ -1,0 +1,278 @@
+/*
+ * hal_core.h - layout of a halsdk instance in shared memory, and the
+ * operations of the core on it.
+ *
+ * Everything in the segment refers to everything else by offset from the
+ * start of the segment (hoff_t, 0 meaning none), so any process can map it
+ * at any address.  The only raw pointers stored in the segment are the
+ * component-owned pin pointer cells (written in the owning process's
+ * address space, from the base address that process recorded in its
+ * component) and the function entry points, which only the host calls.
+ */
+#ifndef HAL_CORE_H
+#define HAL_CORE_H
+
+#define HALSDK_CORE
+#include "halsdk_api.h"
+
+#include <pthread.h>
+#include <stdint.h>
+#include <sys/types.h>
+
+#define HAL_MAGIC 0x31304b4453474c48ULL   /* "HLGSDK01" */
+#define HAL_ABI_VERSION 1
+#define HAL_NAME_SIZE (HALSDK_NAME_LEN + 1)
+#define HAL_DEFAULT_SIZE (160L * 1024 * 1024)
+#define HAL_MIN_SIZE (1L * 1024 * 1024)
+#define HAL_MAX_THREADS 64
+
+typedef uint32_t hoff_t;
+
+typedef union {
+    volatile uint8_t b;
+    volatile int32_t s;
+    volatile uint32_t u;
+    volatile double f;
+    volatile int64_t ls;
+    volatile uint64_t lu;
+} hal_value_t;
+
+enum hal_kind {
+    K_NONE = 0, K_COMP, K_INST, K_PIN, K_PARAM, K_SIG, K_FUNCT, K_THREAD,
+    K_NKINDS
+};
+
+/* lock levels, as the reference numbers them */
+#define HAL_LOCK_NONE 0
+#define HAL_LOCK_LOAD 1
+#define HAL_LOCK_CONFIG 2
+#define HAL_LOCK_PARAMS 4
+#define HAL_LOCK_RUN 8
+#define HAL_LOCK_ALL 255
+
+/* common head of every named object */
+typedef struct {
+    hoff_t next, prev;          /* list of its kind, in creation order */
+    hoff_t hnext;               /* hash chain */
+    uint16_t kind;
+    uint16_t flags;
+    uint32_t hash;
+    uint32_t gen;               /* unique per record; 0 once freed */
+    char name[HAL_NAME_SIZE];
+} hal_obj_t;
+
+typedef struct {
+    hal_obj_t o;
+    int32_t id;
+    int32_t kind;               /* HALSDK_COMP_USER or HALSDK_COMP_RT */
+    int32_t ready;
+    int32_t pid;
+    uint64_t pid_start;         /* start time of pid, to detect reuse */
+    uint64_t base;              /* owner's mapping address of the segment */
+    hoff_t mem;                 /* blocks from hal_malloc, newest first */
+    int32_t ninst;
+} hal_comp_t;
+
+typedef struct {
+    hal_obj_t o;
+    int32_t id;
+    hoff_t comp;
+    hoff_t mem;
+} hal_inst_t;
+
+typedef struct {
+    hal_obj_t o;
+    hoff_t comp, inst;
+    hoff_t ptr_cell;            /* where the owner's pointer to data lives */
+    hoff_t signal;
+    hoff_t oldname;             /* original name while aliased */
+    int16_t type, dir;
+    hal_value_t dummy;          /* the value while unlinked */
+} hal_pin_t;
+
+typedef struct {
+    hal_obj_t o;
+    hoff_t comp, inst;
+    hoff_t data;
+    hoff_t oldname;
+    int16_t type, dir;
+} hal_param_t;
+
+typedef struct {
+    hal_obj_t o;
+    int16_t type, pad;
+    int32_t readers, writers, bidirs;
+    hal_value_t value;
+} hal_sig_t;
+
+typedef struct {
+    hal_obj_t o;
+    hoff_t comp, inst;
+    int32_t uses_fp, reentrant, users;
+    int32_t python;             /* 1: a Python callable, not realtime */
+    uint64_t fn, arg;           /* host addresses */
+    hoff_t time_pin, tmax_param, tmax_inc_param;
+} hal_funct_t;
+
+typedef struct {
+    hoff_t next;
+    hoff_t funct;
+} hal_fentry_t;
+
+typedef struct {
+    hal_obj_t o;
+    int64_t period;
+    int32_t uses_fp, priority;
+    int32_t running;
+    int32_t slot;               /* index of the host's executor */
+    uint32_t timing_every;      /* per-function timing every N cycles */
+    hoff_t comp;
+    hoff_t functs;              /* list of hal_fentry_t, in call order */
+    int32_t nfuncts;
+    hoff_t time_pin, tmax_param;
+    uint64_t cycles, overruns;
+} hal_thread_t;
+
+/* an allocated block; the user data follows the header */
+typedef struct {
+    uint32_t size;              /* usable bytes */
+    uint32_t magic;
+    hoff_t owner;               /* comp or inst owning it, 0: the core */
+    hoff_t next;                /* next block of the owner, or free list */
+} hal_block_t;
+
+#define HAL_BLOCK_USED 0x55534544u
+#define HAL_BLOCK_FREE 0x46524545u
+#define HAL_NCLASSES 64         /* exact-size free lists up to 1 KiB */
+
+typedef struct {
+    uint64_t magic;             /* written last at creation */
+    uint32_t abi;
+    uint32_t header_size;
+    uint64_t size;
+    char instance[64];
+
+    pthread_mutex_t mutex;      /* robust, process-shared: metadata */
+    int32_t host_pid;
+    int32_t pad0;
+    uint64_t host_start;
+    uint64_t host_base;
+    uint32_t serial;            /* bumped on every metadata change */
+    uint32_t next_gen;
+    uint32_t lock;
+
+    int32_t next_id;
+    int32_t msg_level;
+
+    hoff_t heap_start, heap_top, heap_end;
+    hoff_t free_class[HAL_NCLASSES];
+    hoff_t free_big;
+    uint64_t bytes_used;
+
+    hoff_t list_head[K_NKINDS], list_tail[K_NKINDS];
+    int32_t count[K_NKINDS];
+
+    hoff_t buckets;
+    uint32_t nbuckets;
+
+    int32_t sim_clock;          /* 1 while time is simulated by stepping */
+    int64_t sim_time;
+    int32_t threads_running;
+    int32_t recovered;          /* times a dead lock holder was cleaned up */
+} hal_header_t;
+
+/* a mapping of an instance in this process */
+typedef struct {
+    char *base;
+    hal_header_t *hdr;
+    long size;
+    int is_host;
+} hal_map_t;
+
+extern hal_map_t hal_map;       /* the instance this process uses */
+
+#define SHMPTR(off) ((void *)(hal_map.base + (off)))
+#define SHMOFF(ptr) ((hoff_t)((char *)(ptr) - hal_map.base))
+
+/* error reporting: returns -err and keeps a message */
+int hal_fail(int err, const char *fmt, ...)
+    __attribute__((format(printf, 2, 3)));
+const char *hal_last_error(void);
+
+/* instance */
+int hal_instance_create(const char *shm_name, const char *instance,
+                        long size);
+int hal_instance_attach(const char *shm_name);
+void hal_instance_detach(int unlink_shm, const char *shm_name);
+int hal_instance_probe(const char *shm_name, int *host_pid,
+                       uint64_t *host_start, int *abi);
+uint64_t hal_proc_start_time(int pid);
+int hal_pid_alive(int pid, uint64_t start);
+
+/* mutex */
+int hal_lock(void);
+void hal_unlock(void);
+int hal_hold_lock_for_test(double seconds);
+
+/* memory */
+void *hal_alloc(long size, hoff_t owner);
+void hal_free(void *p);
+
+/* lookup */
+void *hal_find(int kind, const char *name);
+hal_comp_t *hal_comp_by_id(int id);
+hal_inst_t *hal_inst_by_id(int id);
+int hal_check_name(const char *name, const char *what);
+
+/* operations, each takes the lock itself; return 0/id or -errno */
+int hal_comp_new(const char *name, int kind);
+int hal_comp_exit(int id);
+int hal_comp_set_ready(int id, int ready);
+int hal_inst_new(const char *name, int comp_id);
+int hal_inst_delete(const char *name);
+void *hal_malloc_owned(long size, int owner_id);
+int hal_pin_new(const char *name, int type, int dir, void **ptr_cell,
+                int owner_id);
+int hal_param_new(const char *name, int type, int dir,
+                  volatile void *data, int owner_id);
+int hal_alias(int kind, const char *name, const char *alias);
+int hal_unalias(int kind, const char *alias);
+int hal_signal_new(const char *name, int type);
+int hal_signal_delete(const char *name);
+int hal_link(const char *pin_name, const char *sig_name);
+int hal_unlink(const char *pin_name);
+int hal_export_funct(const char *name, halsdk_funct_t fn, void *arg,
+                     int uses_fp, int reentrant, int owner_id, int python);
+int hal_thread_new(const char *name, long period, int uses_fp,
+                   unsigned timing_every);
+int hal_thread_delete(const char *name);
+int hal_addf(const char *funct, const char *thread, int position);
+int hal_delf(const char *funct, const char *thread);
+int hal_start_threads(void);
+int hal_stop_threads(void);
+int hal_step(const char *thread, long cycles);
+int hal_set_lock(unsigned char lock);
+int hal_check_consistency(char *report, int len);
+
+/* values */
+hal_value_t *hal_pin_value(hal_pin_t *pin);
+void *hal_param_value(hal_param_t *param);
+
+/* time */
+long long hal_get_time(void);
+long long hal_get_clocks(void);
+
+/* executor (hal_thread.c) */
+int exec_create(hal_thread_t *t);
+void exec_destroy(int slot);
+int exec_publish(hal_thread_t *t);
+int exec_start(int slot, int want_rt, char *note, int notelen);
+void exec_stop(int slot);
+int exec_run_cycles(int slot, long n);
+int exec_step_all(long n);
+int exec_start_all(int want_rt, char *note, int notelen);
+void *hal_malloc_current(long size);
+int exec_stepping(void);
+extern int hal_loading_rt;
+
+#endif /* HAL_CORE_H */

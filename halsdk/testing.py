@@ -1,0 +1,149 @@
+"""pytest plugin: a private HAL instance per test, stepped deterministically.
+
+Installed with halsdk (entry point ``pytest11``), so any project can use::
+
+    def test_my_gain(hal):
+        hal.loadrt("mygain")
+        hal.newthread("servo", 1_000_000)
+        hal.addf("mygain.0", "servo")
+        trace = hal.run(100, inputs={"mygain.0.in": np.linspace(0, 1, 100)},
+                        record=["mygain.0.out"])
+        assert trace["mygain.0.out"][-1] == pytest.approx(2.0)
+
+The ``hal`` fixture creates an instance of its own (``HALSDK_INSTANCE`` is
+set for the test, so child processes and :func:`halsdk.component` find it),
+and removes it afterwards.  At the end of the session the plugin fails the
+run if an instance it created is still in ``/dev/shm``.
+"""
+
+from __future__ import annotations
+
+import itertools
+import os
+from typing import Any, Iterable, Mapping, Optional, Sequence
+
+import numpy as np
+import pytest
+
+import halsdk
+from halsdk import _core
+
+_counter = itertools.count()
+_created: list[str] = []
+TEST_INSTANCE_SIZE = 32 * 1024 * 1024
+
+
+class Trace(dict):
+    """Recorded values: ``trace[name]`` is a NumPy array with one value per
+    cycle; ``trace.time`` holds the simulated time (ns) of each sample."""
+
+    time: np.ndarray
+
+
+_DTYPES = {_core.BIT: np.bool_, _core.FLOAT: np.float64, _core.S32: np.int32,
+           _core.U32: np.uint32, _core.S64: np.int64, _core.U64: np.uint64}
+
+
+class TestHal(halsdk.Hal):
+    """:class:`halsdk.Hal` with helpers for stepping tests."""
+
+    __test__ = False        # not a test class for pytest
+
+    def set(self, values: Mapping[str, Any]) -> None:
+        """Set inputs: unlinked in-pins and params (setp), or signals
+        without a writer (sets)."""
+        for name, value in values.items():
+            item = self._input(name)
+            if isinstance(item, _core.Signal):
+                item.sets(value)
+            else:
+                item.setp(value)
+
+    def _input(self, name: str):
+        item = (_core.find("param", name) or _core.find("pin", name)
+                or _core.find("signal", name))
+        if item is None:
+            raise halsdk.NotFoundError(f"no pin, param or signal '{name}'")
+        return item
+
+    def _source(self, name: str):
+        item = (_core.find("pin", name) or _core.find("signal", name)
+                or _core.find("param", name))
+        if item is None:
+            raise halsdk.NotFoundError(f"no pin, param or signal '{name}'")
+        return item
+
+    def run(self, cycles: int, inputs: Optional[Mapping[str, Any]] = None,
+            record: Iterable[str] = (), thread: Optional[str] = None
+            ) -> Trace:
+        """Step ``cycles`` times, one cycle of the fastest thread (or of
+        ``thread``) each; before each cycle apply ``inputs`` (a scalar, or
+        a sequence giving one value per cycle), after each cycle sample
+        the ``record`` names (pins, signals or params)."""
+        inputs = dict(inputs or {})
+        sources = [(n, self._source(n)) for n in record]
+        plan = []
+        for name, value in inputs.items():
+            target = self._input(name)
+            if isinstance(value, (str, bytes)) or not isinstance(
+                    value, (Sequence, np.ndarray)):
+                self.set({name: value})
+                continue
+            if len(value) != cycles:
+                raise halsdk.InvalidError(
+                    f"input '{name}' has {len(value)} values for {cycles} "
+                    "cycles")
+            setter = target.sets if isinstance(target, _core.Signal) \
+                else target.setp
+            plan.append((setter, value))
+        out = {n: np.empty(cycles, dtype=_DTYPES[src.type])
+               for n, src in sources}
+        times = np.empty(cycles, dtype=np.int64)
+        for k in range(cycles):
+            for setter, value in plan:
+                v = value[k]
+                setter(v.item() if isinstance(v, np.generic) else v)
+            self.step(1, thread)
+            times[k] = _core.get_time()
+            for n, src in sources:
+                out[n][k] = src.value
+        trace = Trace(out)
+        trace.time = times
+        return trace
+
+
+def private_instance_name() -> str:
+    return f"pytest-{os.getpid()}-{next(_counter)}"
+
+
+@pytest.fixture
+def hal(monkeypatch: pytest.MonkeyPatch):
+    """A private HAL instance hosted by the test process."""
+    name = private_instance_name()
+    monkeypatch.setenv("HALSDK_INSTANCE", name)
+    h = TestHal(name, create=True, size=TEST_INSTANCE_SIZE)
+    _created.append(halsdk.instance.shm_name(name))
+    try:
+        yield h
+    finally:
+        try:
+            h.stop()
+        except halsdk.HalError:
+            pass
+        conn = halsdk.instance.current()
+        h.close()
+        # components the test left open must not keep the instance alive
+        if conn is not None and halsdk.instance.current() is conn:
+            halsdk.instance._teardown(conn)
+
+
+def leftover_instances(shm_names: Iterable[str]) -> list[str]:
+    return [n for n in shm_names
+            if os.path.exists("/dev/shm/" + n.lstrip("/"))]
+
+
+def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
+    left = leftover_instances(_created)
+    if left:
+        print(f"\nhalsdk: HAL instances left in /dev/shm: {', '.join(left)}")
+        session.exitstatus = 1

@@ -1,0 +1,51 @@
+"""Suite-wide setup: the test components, and the /dev/shm check."""
+
+from __future__ import annotations
+
+import os
+
+import pytest
+
+from halsdk.build import build_component
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+COMPONENTS = os.path.join(HERE, "components")
+TEST_COMPONENTS = ["tand2.pyx", "tcounter.pyx", "tlowpass.pyx", "cscale.c"]
+
+
+def _halsdk_segments() -> set[str]:
+    prefix = f"halsdk-{os.getuid()}"
+    return {n for n in os.listdir("/dev/shm") if n.startswith(prefix)}
+
+
+_before: set[str] = set()
+
+
+def pytest_sessionstart(session: pytest.Session) -> None:
+    _before.update(_halsdk_segments())
+
+
+def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
+    """The suite ends by checking that no test left an instance behind."""
+    left = sorted(_halsdk_segments() - _before)
+    if left:
+        print(f"\nFAILED: HAL instances left in /dev/shm: {', '.join(left)}")
+        session.exitstatus = 1
+    else:
+        print("\n/dev/shm check: no HAL instance left behind")
+
+
+@pytest.fixture(scope="session", autouse=True)
+def component_path(tmp_path_factory: pytest.TempPathFactory) -> str:
+    """Build the test components (cached by content) into a folder on
+    HALSDK_PATH, so that loadrt finds them by name."""
+    folder = str(tmp_path_factory.mktemp("halsdk-path"))
+    for source in TEST_COMPONENTS:
+        build_component(os.path.join(COMPONENTS, source), out_dir=folder)
+    old = os.environ.get("HALSDK_PATH")
+    os.environ["HALSDK_PATH"] = folder + (os.pathsep + old if old else "")
+    yield folder
+    if old is None:
+        os.environ.pop("HALSDK_PATH", None)
+    else:
+        os.environ["HALSDK_PATH"] = old
