@@ -14,10 +14,19 @@ Typical use::
 
 from halsdk import _core
 from halsdk.component import Component, component
-from halsdk.errors import (CapacityError, ConflictError, ExistsError,
-                           HalError, HalTypeError, InstanceError, InvalidError,
-                           LoadError, NotFoundError, NotPermittedError,
-                           StaleError)
+from halsdk.errors import (
+                           CapacityError,
+                           ConflictError,
+                           ExistsError,
+                           HalError,
+                           HalTypeError,
+                           InstanceError,
+                           InvalidError,
+                           LoadError,
+                           NotFoundError,
+                           NotPermittedError,
+                           StaleError,
+)
 from halsdk.hal import Hal
 from halsdk.instance import cleanup
 from halsdk.types import Direction, HalType

@@ -733,6 +733,7 @@ def attach(str shm_name):
 def detach(bint unlink=False, shm_name=None):
     """Unmap the instance; the host also removes it."""
     cdef bytes b
+    _python_functs.clear()
     if shm_name:
         b = enc(shm_name)
         hal_instance_detach(unlink, b)

@@ -2,7 +2,7 @@
 
 Every rule violation raises a subclass of :class:`HalError` whose message
 names the object concerned.  The subclasses also derive from the closest
-built-in exception, so ``except KeyError`` catches an unknown name.
+built-in exception, so ``except LookupError`` catches an unknown name.
 """
 
 
@@ -50,4 +50,5 @@ class StaleError(HalError):
 
 
 class LoadError(HalError):
-    """A component module cannot be found, imported or set up."""
+    """A component module fails to import or to set up (a module that is
+    not found at all raises :class:`NotFoundError`)."""

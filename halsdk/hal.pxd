@@ -103,6 +103,10 @@ cdef extern from "hal.h" nogil:
     int hal_set_lock(unsigned char lock_type)
     unsigned char hal_get_lock()
 
+    # halsdk additions
+    int halsdk_inst_new(const char *name, int comp_id)
+    const char *halsdk_last_error()
+
 cdef extern from "rtapi.h" nogil:
     ctypedef enum msg_level_t:
         RTAPI_MSG_NONE, RTAPI_MSG_ERR, RTAPI_MSG_WARN, RTAPI_MSG_INFO

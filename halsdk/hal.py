@@ -6,11 +6,17 @@ import fnmatch
 import os
 import signal as _signal
 import time
-from typing import Any, Callable, Iterable, Optional, Union
+from collections.abc import Iterable
+from typing import Any, Callable, Optional, Union
 
 from halsdk import _core, channel, instance
-from halsdk.errors import (ConflictError, HalTypeError, InvalidError,
-                           NotFoundError, NotPermittedError)
+from halsdk.errors import (
+    ConflictError,
+    HalTypeError,
+    InvalidError,
+    NotFoundError,
+    NotPermittedError,
+)
 from halsdk.loader import Registry
 from halsdk.types import Direction, HalType, parse_type
 

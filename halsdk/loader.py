@@ -38,8 +38,7 @@ from types import ModuleType
 from typing import Any, Optional
 
 from halsdk import _core
-from halsdk.errors import (ExistsError, HalError, InvalidError, LoadError,
-                           NotFoundError)
+from halsdk.errors import ExistsError, HalError, InvalidError, LoadError, NotFoundError
 
 _MODULE_NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 _KINDS = {int: "i", float: "f", str: "s"}

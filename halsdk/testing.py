@@ -20,7 +20,8 @@ from __future__ import annotations
 
 import itertools
 import os
-from typing import Any, Iterable, Mapping, Optional, Sequence
+from collections.abc import Iterable, Mapping, Sequence
+from typing import Any, Optional
 
 import numpy as np
 import pytest

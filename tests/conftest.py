@@ -14,8 +14,13 @@ TEST_COMPONENTS = ["tand2.pyx", "tcounter.pyx", "tlowpass.pyx", "cscale.c"]
 
 
 def _halsdk_segments() -> set[str]:
+    """Instances of this session: their names carry the session's pid (the
+    fixture's and the tests' private names do), so a second pytest session
+    running alongside is not counted."""
     prefix = f"halsdk-{os.getuid()}"
-    return {n for n in os.listdir("/dev/shm") if n.startswith(prefix)}
+    mark = f"-{os.getpid()}"
+    return {n for n in os.listdir("/dev/shm")
+            if n.startswith(prefix) and (mark + "-" in n or n.endswith(mark))}
 
 
 _before: set[str] = set()

@@ -365,7 +365,7 @@ def test_stale_handles_raise(hal):
     comp.exit()
     assert not pin.exists
     with pytest.raises(halsdk.StaleError, match="pin 'gone.x'"):
-        pin.value
+        _ = pin.value
     # a new object in the same place is not mistaken for the old one
     comp2 = halsdk.component("gone")
     comp2.newpin("x", "bit", "in")

@@ -263,6 +263,17 @@ static inline int hal_stop_threads(void)
     return HALSDK_API->stop_threads();
 }
 
+/* halsdk additions: instances made at run time (newinst), and the
+   message of the last failed call */
+static inline int halsdk_inst_new(const char *name, int comp_id)
+{
+    return HALSDK_API->inst_new(name, comp_id);
+}
+static inline const char *halsdk_last_error(void)
+{
+    return HALSDK_API->last_error();
+}
+
 static inline int hal_set_lock(unsigned char lock_type)
 {
     return HALSDK_API->set_lock(lock_type);

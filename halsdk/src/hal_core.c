@@ -314,13 +314,16 @@ int hal_check_name(const char *name, const char *what)
         return hal_fail(EINVAL, "%s name '%.*s...' is longer than %d "
                         "characters", what, 40, name, HALSDK_NAME_LEN);
     for (const unsigned char *p = (const unsigned char *)name; *p; p++) {
-        if (*p <= ' ' || *p >= 127 || *p == '"' || *p == '\'' ||
-            *p == '#' || *p == '\\' || *p == '$' || *p == '[' || *p == ']')
+        if (*p == ' ')
+            return hal_fail(EINVAL, "%s name '%s' contains a blank", what,
+                            name);
+        if (*p < ' ' || *p >= 127)
+            return hal_fail(EINVAL, "%s name '%s' contains a non-printable "
+                            "or non-ASCII character", what, name);
+        if (strchr("\"'#\\$[]", *p))
             return hal_fail(EINVAL, "%s name '%s' contains the character "
-                            "'%s' (allowed: printable ASCII without "
-                            "blanks, quotes, #, $, [, ] or \\)", what,
-                            name, *p <= ' ' || *p >= 127 ? "non-printable"
-                            : (char[]){(char)*p, 0});
+                            "'%c' (not allowed: blanks, quotes, #, $, [, ] "
+                            "and \\)", what, name, *p);
     }
     if (name[0] == '.' || name[n - 1] == '.' || strstr(name, ".."))
         return hal_fail(EINVAL, "%s name '%s' has an empty level "
@@ -1618,6 +1621,8 @@ void hal_instance_detach(int unlink_shm, const char *shm_name)
 {
     if (!hal_map.hdr)
         return;
+    if (hal_map.is_host)
+        exec_destroy_all();
     munmap(hal_map.base, hal_map.size);
     memset(&hal_map, 0, sizeof(hal_map));
     cur_owner = 0;

@@ -265,6 +265,7 @@ long long hal_get_clocks(void);
 /* executor (hal_thread.c) */
 int exec_create(hal_thread_t *t);
 void exec_destroy(int slot);
+void exec_destroy_all(void);
 int exec_publish(hal_thread_t *t);
 int exec_start(int slot, int want_rt, char *note, int notelen);
 void exec_stop(int slot);

@@ -207,6 +207,13 @@ void exec_destroy(int slot)
     x->used = 0;
 }
 
+/* the host is leaving its instance: no executor may outlive it */
+void exec_destroy_all(void)
+{
+    for (int s = 0; s < HAL_MAX_THREADS; s++)
+        exec_destroy(s);
+}
+
 int exec_publish(hal_thread_t *t)
 {
     if (!hal_map.is_host)

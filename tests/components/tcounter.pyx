@@ -63,16 +63,10 @@ def setup(names=("tcounter.0",)):
     hal.hal_ready(comp_id)
 
 
-cdef extern from "halsdk_api.h":
-    ctypedef struct halsdk_api:
-        int (*inst_new)(const char *name, int comp_id)
-    const halsdk_api *halsdk_api_ptr
-
-
 def new_instance(name, step=1):
-    cdef int inst = halsdk_api_ptr.inst_new(name.encode(), comp_id)
+    cdef int inst = hal.halsdk_inst_new(name.encode(), comp_id)
     if inst < 0:
-        raise RuntimeError(f"cannot create instance '{name}'")
+        raise RuntimeError(hal.halsdk_last_error().decode())
     make(name.encode(), inst, step)
 
 

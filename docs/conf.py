@@ -1,0 +1,45 @@
+"""Sphinx configuration of the halsdk documentation.
+
+Build: ``python -m sphinx -W --keep-going -b html docs docs/_build/html``.
+The API pages are made by autodoc, so :mod:`halsdk` (with its compiled core)
+must be importable: install the project (``pip install -e .``) first.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.dirname(HERE))      # the repository root
+
+import halsdk  # noqa: E402  (after the path change)
+
+project = "halsdk"
+author = "the halsdk authors"
+copyright = "the halsdk authors"
+release = halsdk.__version__
+version = ".".join(release.split(".")[:2])
+
+extensions = [
+    "sphinx.ext.autodoc",
+    "myst_parser",
+]
+
+source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
+root_doc = "index"
+exclude_patterns = ["_build", "Thumbs.db", ".DS_Store"]
+
+nitpicky = False
+default_role = "code"
+highlight_language = "python"
+
+autodoc_member_order = "bysource"
+autodoc_typehints = "signature"
+autodoc_default_options = {"members": True}
+
+myst_heading_anchors = 3
+
+html_theme = "alabaster"
+html_title = f"halsdk {release}"
+html_static_path: list[str] = []

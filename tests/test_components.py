@@ -1,0 +1,196 @@
+"""Compiled components: three written in Cython and one in C, loaded by
+name through the module entry convention and run in threads."""
+
+from __future__ import annotations
+
+import os
+import sys
+import time
+
+import pytest
+
+import halsdk
+from halsdk import _core
+from halsdk.build import BuildError, build_component
+from halsdk.loader import import_component
+
+
+def test_cython_gate_by_name_in_a_thread(hal):
+    assert hal.loadrt("tand2", count=3) == ["tand2"]
+    hal.newthread("servo", 1_000_000, fp=False)
+    for k in range(3):
+        hal.addf(f"tand2.{k}", "servo")
+    hal.net("chain", "tand2.0.out", "tand2.1.in0")
+    hal.setp("tand2.1.in1", 1)
+    table = [(0, 0, False), (0, 1, False), (1, 0, False), (1, 1, True)]
+    for a, b, want in table:
+        hal.set({"tand2.0.in0": a, "tand2.0.in1": b})
+        hal.step(1)
+        assert hal.getp("tand2.0.out") is want
+        assert hal.getp("tand2.1.out") is want
+    names = [p.name for p in hal.pins("tand2.0.*")]
+    assert names == ["tand2.0.in0", "tand2.0.in1", "tand2.0.out",
+                     "tand2.0.time"]
+    assert [p.name for p in hal.params("tand2.0.*")] == [
+        "tand2.0.tmax", "tand2.0.tmax-increased"]
+
+
+def test_c_component_with_modparams(hal):
+    assert hal.loadrt("cscale", "count=2 prefix=sc") == ["cscale"]
+    hal.newthread("servo", 1_000_000)
+    hal.addf("sc.0", "servo")
+    hal.addf("sc.1", "servo")
+    assert hal.getp("sc.0.gain") == 1.0          # set by rtapi_app_main
+    hal.set({"sc.0.in": 2.0, "sc.0.gain": 3.0, "sc.0.offset": -1.0,
+             "sc.1.in": 4.0})
+    hal.step(10)
+    assert hal.getp("sc.0.out") == 5.0
+    assert hal.getp("sc.1.out") == 4.0
+    assert hal.getp("sc.0.calls") == 10
+    module = import_component("cscale")
+    assert module.modparams["count"][0] == "i"
+    assert module.modparams["limits"][0] == "I"
+    assert "scalers" in module.modparams["count"][2]
+
+
+def test_c_component_runs_in_realtime(hal):
+    hal.loadrt("cscale")
+    hal.newthread("servo", 500_000)
+    hal.addf("cscale.0", "servo")
+    hal.setp("cscale.0.in", 1.5)
+    hal.start()
+    deadline = time.monotonic() + 5
+    while hal.getp("cscale.0.calls") < 50 and time.monotonic() < deadline:
+        time.sleep(0.01)
+    hal.stop()
+    assert hal.getp("cscale.0.calls") >= 50
+    assert hal.getp("cscale.0.out") == 1.5
+
+
+def test_c_component_reload_starts_from_default_params(hal):
+    hal.loadrt("cscale", count=3, prefix="x")
+    assert len(hal.functions("x.*")) == 3
+    hal.unloadrt("cscale")
+    assert hal.pins("x.*") == [] and hal.components("cscale") == []
+    hal.loadrt("cscale")
+    assert [f.name for f in hal.functions()] == ["cscale.0"]
+
+
+def test_failed_setup_leaves_nothing(hal):
+    before = hal.info()["counts"]
+    with pytest.raises(halsdk.LoadError, match="rtapi_app_main"):
+        hal.loadrt("cscale", count=100)
+    assert hal.info()["counts"] == before
+    with pytest.raises(halsdk.LoadError, match="count=0"):
+        hal.loadrt("tand2", count=0)
+    assert hal.components() == []
+    hal.loadrt("cscale")          # and it can be loaded afterwards
+    hal.check()
+
+
+def test_modparam_errors(hal):
+    with pytest.raises(halsdk.InvalidError, match="unknown parameter 'cnt'"):
+        hal.loadrt("tand2", cnt=2)
+    with pytest.raises(halsdk.InvalidError, match="not an integer"):
+        hal.loadrt("tand2 count=two")
+    with pytest.raises(halsdk.InvalidError, match="not name=value"):
+        hal.loadrt("tand2 count")
+    with pytest.raises(halsdk.NotFoundError, match="'nosuchcomp' not found"):
+        hal.loadrt("nosuchcomp")
+    with pytest.raises(halsdk.InvalidError, match="module name"):
+        hal.loadrt("../etc")
+    with pytest.raises(halsdk.ExistsError, match="already loaded"):
+        hal.loadrt("tand2")
+        hal.loadrt("tand2")
+    assert hal.components() == [hal.component("tand2")]
+
+
+def test_64_bit_counter_and_instances(hal):
+    hal.loadrt("tcounter", names="c1")
+    hal.newthread("servo", 1_000_000, fp=False)
+    hal.addf("c1", "servo")
+    hal.setp("c1.step", 1 << 40)
+    for level in (1, 0, 1, 0, 1):
+        hal.setp("c1.in", level)
+        hal.step(1)
+    assert hal.getp("c1.count") == 3 << 40
+    assert hal.getp("c1.cycles") == 5
+    hal.newinst("tcounter", "extra", step=7)
+    assert hal.instances()[0].name == "extra"
+    assert hal.instances()[0].owner == "tcounter"
+    hal.addf("extra", "servo")
+    hal.setp("extra.in", 1)
+    hal.step(1)
+    assert hal.getp("extra.count") == 7
+    hal.delinst("extra")
+    assert hal.pins("extra.*") == [] and hal.functions("extra") == []
+    assert hal.thread("servo").functions == ["c1"]
+    assert sys.modules["halsdk._loaded.tcounter"].deleted == ["extra"]
+    hal.step(1)                  # the thread runs on without it
+    with pytest.raises(halsdk.NotPermittedError, match="instances"):
+        hal.loadrt("tand2")
+        hal.newinst("tand2", "x")
+    with pytest.raises(halsdk.NotFoundError):
+        hal.delinst("extra")
+    hal.check()
+
+
+def test_unload_all(hal):
+    hal.loadrt("tand2")
+    hal.loadrt("tlowpass")
+    hal.newthread("servo", 1_000_000)
+    hal.addf("tand2.0", "servo")
+    hal.unloadrt("all")
+    assert hal.components() == [hal.component("__servo")]
+    assert hal.thread("servo").functions == []
+
+
+def test_build_errors_name_the_file(tmp_path):
+    bad = tmp_path / "broken.pyx"
+    bad.write_text("def setup(:\n")
+    with pytest.raises(BuildError, match="broken.pyx"):
+        build_component(str(bad), out_dir=str(tmp_path / "out"))
+    cbad = tmp_path / "cbroken.c"
+    cbad.write_text('#include "hal.h"\nint rtapi_app_main(void) '
+                    '{ return undefined_thing; }\n')
+    with pytest.raises(BuildError, match="undefined_thing"):
+        build_component(str(cbad), out_dir=str(tmp_path / "out"))
+    with pytest.raises(BuildError, match="valid module name"):
+        build_component(str(bad), name="bad-name")
+
+
+def test_build_is_cached(tmp_path):
+    src = os.path.join(os.path.dirname(__file__), "components", "tand2.pyx")
+    first = build_component(src)
+    mtime = os.path.getmtime(first)
+    assert build_component(src) == first
+    assert os.path.getmtime(first) == mtime
+
+
+def test_component_from_entry_point_group(hal, tmp_path, monkeypatch):
+    """Third-party packages ship components under the entry-point group
+    'halsdk.components'."""
+    pkg = tmp_path / "thirdparty_comp"
+    pkg.mkdir()
+    (pkg / "__init__.py").write_text(
+        "import halsdk\n"
+        "modparams = {'gain': (float, 1.0, 'gain')}\n"
+        "made = []\n"
+        "def setup(gain=1.0):\n"
+        "    from halsdk import _core\n"
+        "    cid = _core.comp_new('tpy', _core.COMP_RT)\n"
+        "    made.append(gain)\n"
+        "    _core.comp_ready(cid)\n")
+    dist = tmp_path / "thirdparty_comp-1.0.dist-info"
+    dist.mkdir()
+    (dist / "METADATA").write_text("Name: thirdparty-comp\nVersion: 1.0\n")
+    (dist / "entry_points.txt").write_text(
+        "[halsdk.components]\ntpy = thirdparty_comp\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    assert hal.loadrt("tpy", gain="2.5") == ["tpy"]
+    assert sys.modules["thirdparty_comp"].made == [2.5]
+    assert hal.component("tpy").realtime
+    _core_items = [c.name for c in hal.components()]
+    assert "tpy" in _core_items
+    hal.unloadrt("tpy")
+    assert _core.find("component", "tpy") is None
