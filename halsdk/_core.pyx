@@ -172,6 +172,28 @@ cdef extern from "hal_core.h" nogil:
     hal_value_t *hal_pin_value(hal_pin_t *pin)
     void *hal_param_value(hal_param_t *param)
     long long hal_get_time()
+    void *(*hal_gil_release)() noexcept nogil
+    void (*hal_gil_restore)(void *) noexcept nogil
+
+cdef extern from "Python.h":
+    ctypedef struct PyThreadState
+    int PyGILState_Check() noexcept nogil
+    PyThreadState *PyEval_SaveThread() noexcept nogil
+    void PyEval_RestoreThread(PyThreadState *) noexcept nogil
+
+
+cdef void *gil_release() noexcept nogil:
+    if PyGILState_Check():
+        return <void *>PyEval_SaveThread()
+    return NULL
+
+
+cdef void gil_restore(void *state) noexcept nogil:
+    PyEval_RestoreThread(<PyThreadState *>state)
+
+
+hal_gil_release = gil_release
+hal_gil_restore = gil_restore
 
 cdef inline void *SHMPTR(hoff_t off) noexcept nogil:
     return <void *>(hal_map.base + off)
@@ -223,6 +245,19 @@ cdef int check(int r) except -1:
         return r
     msg = hal_last_error().decode("utf-8", "replace")
     raise _ERRNO_CLASS.get(-r, _errors.HalError)(msg)
+
+
+cdef int lock() except -1:
+    """Take the instance mutex without holding the GIL while waiting.
+
+    A core operation may hold the mutex while it waits for a thread cycle
+    to end, and a cycle may run a Python function that needs the GIL: so
+    no thread may wait for the mutex with the GIL held.
+    """
+    cdef int r
+    with nogil:
+        r = hal_lock()
+    return check(r)
 
 
 cdef bytes enc(name):
@@ -349,6 +384,7 @@ cdef class Item:
 
     @property
     def name(self) -> str:
+        """The object's current name (its alias, if it has one)."""
         cdef hal_obj_t *o = <hal_obj_t *>self.rec()
         return o.name.decode("utf-8", "replace")
 
@@ -396,18 +432,22 @@ cdef class Pin(Item):
 
     @property
     def type(self) -> int:
+        """HAL type number (see :class:`halsdk.HalType`)."""
         return (<hal_pin_t *>self.rec()).type
 
     @property
     def direction(self) -> int:
+        """Direction number (see :class:`halsdk.Direction`)."""
         return (<hal_pin_t *>self.rec()).dir
 
     @property
     def owner(self) -> str:
+        """Name of the owning component."""
         return comp_name((<hal_pin_t *>self.rec()).comp)
 
     @property
     def owner_id(self) -> int:
+        """Id of the owning component."""
         return (<hal_comp_t *>SHMPTR((<hal_pin_t *>self.rec()).comp)).id
 
     @property
@@ -420,6 +460,7 @@ cdef class Pin(Item):
 
     @property
     def linked(self) -> bool:
+        """True while linked to a signal."""
         return (<hal_pin_t *>self.rec()).signal != 0
 
     @property
@@ -467,18 +508,22 @@ cdef class Param(Item):
 
     @property
     def type(self) -> int:
+        """HAL type number (see :class:`halsdk.HalType`)."""
         return (<hal_param_t *>self.rec()).type
 
     @property
     def direction(self) -> int:
+        """Direction number (see :class:`halsdk.Direction`)."""
         return (<hal_param_t *>self.rec()).dir
 
     @property
     def owner(self) -> str:
+        """Name of the owning component."""
         return comp_name((<hal_param_t *>self.rec()).comp)
 
     @property
     def owner_id(self) -> int:
+        """Id of the owning component."""
         return (<hal_comp_t *>SHMPTR((<hal_param_t *>self.rec()).comp)).id
 
     @property
@@ -522,6 +567,7 @@ cdef class Signal(Item):
 
     @property
     def type(self) -> int:
+        """HAL type number (see :class:`halsdk.HalType`)."""
         return (<hal_sig_t *>self.rec()).type
 
     @property
@@ -548,14 +594,17 @@ cdef class Signal(Item):
 
     @property
     def writers(self) -> int:
+        """Number of out pins linked (0 or 1)."""
         return (<hal_sig_t *>self.rec()).writers
 
     @property
     def readers(self) -> int:
+        """Number of in pins linked."""
         return (<hal_sig_t *>self.rec()).readers
 
     @property
     def bidirs(self) -> int:
+        """Number of io pins linked."""
         return (<hal_sig_t *>self.rec()).bidirs
 
     @property
@@ -566,7 +615,7 @@ cdef class Signal(Item):
         cdef hoff_t o
         cdef hal_pin_t *p
         out = []
-        hal_lock()
+        lock()
         try:
             o = hal_map.hdr.list_head[K_PIN]
             while o:
@@ -584,6 +633,7 @@ cdef class Component(Item):
 
     @property
     def id(self) -> int:
+        """Component (or instance) id."""
         return (<hal_comp_t *>self.rec()).id
 
     @property
@@ -592,10 +642,12 @@ cdef class Component(Item):
 
     @property
     def ready(self) -> bool:
+        """True once the component called hal_ready()."""
         return (<hal_comp_t *>self.rec()).ready != 0
 
     @property
     def pid(self) -> int:
+        """Process that owns the component."""
         return (<hal_comp_t *>self.rec()).pid
 
     @property
@@ -610,10 +662,12 @@ cdef class Instance(Item):
 
     @property
     def id(self) -> int:
+        """Component (or instance) id."""
         return (<hal_inst_t *>self.rec()).id
 
     @property
     def owner(self) -> str:
+        """Name of the owning component."""
         return comp_name((<hal_inst_t *>self.rec()).comp)
 
 
@@ -622,22 +676,27 @@ cdef class Function(Item):
 
     @property
     def owner(self) -> str:
+        """Name of the owning component."""
         return comp_name((<hal_funct_t *>self.rec()).comp)
 
     @property
     def owner_id(self) -> int:
+        """Id of the owning component."""
         return (<hal_comp_t *>SHMPTR((<hal_funct_t *>self.rec()).comp)).id
 
     @property
     def uses_fp(self) -> bool:
+        """True if it uses floating point."""
         return (<hal_funct_t *>self.rec()).uses_fp != 0
 
     @property
     def reentrant(self) -> bool:
+        """True if it may be in several threads."""
         return (<hal_funct_t *>self.rec()).reentrant != 0
 
     @property
     def users(self) -> int:
+        """Number of thread entries that call it."""
         return (<hal_funct_t *>self.rec()).users
 
     @property
@@ -647,11 +706,13 @@ cdef class Function(Item):
 
     @property
     def time(self) -> int:
+        """Last measured run time in ns (the ``.time`` pin)."""
         cdef hal_funct_t *f = <hal_funct_t *>self.rec()
         return hal_pin_value(<hal_pin_t *>SHMPTR(f.time_pin)).s
 
     @property
     def tmax(self) -> int:
+        """Largest measured run time in ns (the ``.tmax`` param)."""
         cdef hal_funct_t *f = <hal_funct_t *>self.rec()
         return (<int32_t *>hal_param_value(
             <hal_param_t *>SHMPTR(f.tmax_param)))[0]
@@ -662,35 +723,43 @@ cdef class Thread(Item):
 
     @property
     def period(self) -> int:
+        """Period in ns."""
         return (<hal_thread_t *>self.rec()).period
 
     @property
     def uses_fp(self) -> bool:
+        """True if it uses floating point."""
         return (<hal_thread_t *>self.rec()).uses_fp != 0
 
     @property
     def running(self) -> bool:
+        """True while its pthread runs (start .. stop)."""
         return (<hal_thread_t *>self.rec()).running != 0
 
     @property
     def timing_every(self) -> int:
+        """Functions are timed every this many cycles."""
         return (<hal_thread_t *>self.rec()).timing_every
 
     @property
     def cycles(self) -> int:
+        """Cycles run so far (realtime and stepped)."""
         return (<hal_thread_t *>self.rec()).cycles
 
     @property
     def overruns(self) -> int:
+        """Cycles that ended after the next one was due."""
         return (<hal_thread_t *>self.rec()).overruns
 
     @property
     def time(self) -> int:
+        """Last measured run time in ns (the ``.time`` pin)."""
         cdef hal_thread_t *t = <hal_thread_t *>self.rec()
         return hal_pin_value(<hal_pin_t *>SHMPTR(t.time_pin)).s
 
     @property
     def tmax(self) -> int:
+        """Largest measured run time in ns (the ``.tmax`` param)."""
         cdef hal_thread_t *t = <hal_thread_t *>self.rec()
         return (<int32_t *>hal_param_value(
             <hal_param_t *>SHMPTR(t.tmax_param)))[0]
@@ -701,7 +770,7 @@ cdef class Thread(Item):
         cdef hal_thread_t *t = <hal_thread_t *>self.rec()
         cdef hoff_t e
         out = []
-        hal_lock()
+        lock()
         try:
             e = t.functs
             while e:
@@ -722,7 +791,13 @@ _KIND_CLASS = {K_COMP: Component, K_INST: Instance, K_PIN: Pin,
 
 def create(str shm_name, str instance, long size=0):
     """Create the instance and become its host."""
-    check(hal_instance_create(enc(shm_name), enc(instance), size))
+    cdef bytes a = enc(shm_name), b = enc(instance)
+    cdef const char *ca = a
+    cdef const char *cb = b
+    cdef int r
+    with nogil:
+        r = hal_instance_create(ca, cb, size)
+    check(r)
 
 
 def attach(str shm_name):
@@ -826,7 +901,9 @@ def check_consistency():
     """(number of problems, last problem) of the instance invariants."""
     need_instance()
     cdef char rep[512]
-    n = hal_check_consistency(rep, sizeof(rep))
+    cdef int n
+    with nogil:
+        n = hal_check_consistency(rep, sizeof(rep))
     return n, rep.decode("utf-8", "replace")
 
 
@@ -841,7 +918,7 @@ def find(str kind, name):
     cdef int k = _KIND_BY_WORD[kind]
     cdef bytes b = enc(name)
     cdef void *p
-    hal_lock()
+    lock()
     try:
         p = hal_find(k, b)
         return make(k, p) if p != NULL else None
@@ -856,7 +933,7 @@ def items(str kind):
     cdef hoff_t o
     cdef hal_obj_t *obj
     out = []
-    hal_lock()
+    lock()
     try:
         o = hal_map.hdr.list_head[k]
         while o:
@@ -871,7 +948,7 @@ def items(str kind):
 def comp_by_id(int id):
     need_instance()
     cdef hal_comp_t *c
-    hal_lock()
+    lock()
     try:
         c = hal_comp_by_id(id)
         return make(K_COMP, c) if c != NULL else None
@@ -887,7 +964,12 @@ def check_name(name, str what="object"):
 
 def comp_new(name, int kind):
     need_instance()
-    return check(hal_comp_new(enc(name), kind))
+    cdef bytes b = enc(name)
+    cdef const char *cb = b
+    cdef int r
+    with nogil:
+        r = hal_comp_new(cb, kind)
+    return check(r)
 
 
 def comp_exit(int comp_id):
@@ -901,12 +983,20 @@ def comp_exit(int comp_id):
 
 def comp_ready(int comp_id, bint ready=True):
     need_instance()
-    check(hal_comp_set_ready(comp_id, ready))
+    cdef int r
+    with nogil:
+        r = hal_comp_set_ready(comp_id, ready)
+    check(r)
 
 
 def inst_new(name, int comp_id):
     need_instance()
-    return check(hal_inst_new(enc(name), comp_id))
+    cdef bytes b = enc(name)
+    cdef const char *cb = b
+    cdef int r
+    with nogil:
+        r = hal_inst_new(cb, comp_id)
+    return check(r)
 
 
 def inst_delete(name):
@@ -924,10 +1014,16 @@ def pin_new(name, int type, int dir, int owner_id):
     need_instance()
     cdef bytes b = enc(name)
     check(hal_check_name(b, b"pin"))
-    cdef void **cell = <void **>hal_malloc_owned(sizeof(void *), owner_id)
+    cdef const char *cb = b
+    cdef void **cell
+    cdef int r
+    with nogil:
+        cell = <void **>hal_malloc_owned(sizeof(void *), owner_id)
     if cell == NULL:
         check(-12)
-    check(hal_pin_new(b, type, dir, cell, owner_id))
+    with nogil:
+        r = hal_pin_new(cb, type, dir, cell, owner_id)
+    check(r)
     return find("pin", name)
 
 
@@ -936,49 +1032,93 @@ def param_new(name, int type, int dir, int owner_id):
     need_instance()
     cdef bytes b = enc(name)
     check(hal_check_name(b, b"param"))
-    cdef void *data = hal_malloc_owned(8, owner_id)
+    cdef const char *cb = b
+    cdef void *data
+    cdef int r
+    with nogil:
+        data = hal_malloc_owned(8, owner_id)
     if data == NULL:
         check(-12)
-    check(hal_param_new(b, type, dir, data, owner_id))
+    with nogil:
+        r = hal_param_new(cb, type, dir, data, owner_id)
+    check(r)
     return find("param", name)
 
 
 def alias(str kind, name, alias_name):
     need_instance()
-    check(hal_alias(_KIND_BY_WORD[kind], enc(name), enc(alias_name)))
+    cdef int k = _KIND_BY_WORD[kind]
+    cdef bytes a = enc(name), b = enc(alias_name)
+    cdef const char *ca = a
+    cdef const char *cb = b
+    cdef int r
+    with nogil:
+        r = hal_alias(k, ca, cb)
+    check(r)
 
 
 def unalias(str kind, alias_name):
     need_instance()
-    check(hal_unalias(_KIND_BY_WORD[kind], enc(alias_name)))
+    cdef int k = _KIND_BY_WORD[kind]
+    cdef bytes b = enc(alias_name)
+    cdef const char *cb = b
+    cdef int r
+    with nogil:
+        r = hal_unalias(k, cb)
+    check(r)
 
 
 def signal_new(name, int type):
     need_instance()
-    check(hal_signal_new(enc(name), type))
+    cdef bytes b = enc(name)
+    cdef const char *cb = b
+    cdef int r
+    with nogil:
+        r = hal_signal_new(cb, type)
+    check(r)
     return find("signal", name)
 
 
 def signal_delete(name):
     need_instance()
-    check(hal_signal_delete(enc(name)))
+    cdef bytes b = enc(name)
+    cdef const char *cb = b
+    cdef int r
+    with nogil:
+        r = hal_signal_delete(cb)
+    check(r)
 
 
 def link(pin, sig):
     need_instance()
-    check(hal_link(enc(pin), enc(sig)))
+    cdef bytes a = enc(pin), b = enc(sig)
+    cdef const char *ca = a
+    cdef const char *cb = b
+    cdef int r
+    with nogil:
+        r = hal_link(ca, cb)
+    check(r)
 
 
 def unlink(pin):
     need_instance()
-    check(hal_unlink(enc(pin)))
+    cdef bytes b = enc(pin)
+    cdef const char *cb = b
+    cdef int r
+    with nogil:
+        r = hal_unlink(cb)
+    check(r)
 
 
 def set_lock(int level):
     need_instance()
     if not 0 <= level <= 255:
         raise _errors.InvalidError(f"lock level {level} is not 0..255")
-    check(hal_set_lock(level))
+    cdef unsigned char lv = level
+    cdef int r
+    with nogil:
+        r = hal_set_lock(lv)
+    check(r)
 
 
 def get_lock() -> int:
@@ -1028,8 +1168,14 @@ def export_python(name, fn, int owner_id, bint uses_fp=True):
     pf = _PyFunct()
     pf.fn = fn
     pf.name = name
-    check(hal_export_funct(enc(name), py_trampoline, <void *>pf, uses_fp,
-                           0, owner_id, 1))
+    cdef bytes b = enc(name)
+    cdef const char *cb = b
+    cdef void *arg = <void *>pf
+    cdef int r
+    with nogil:
+        r = hal_export_funct(cb, py_trampoline, arg, uses_fp, 0, owner_id,
+                             1)
+    check(r)
     _python_functs[name] = (owner_id, pf)
 
 
@@ -1046,7 +1192,12 @@ def _drop_python_functs(int comp_id):
 def thread_new(name, long period, bint uses_fp=True,
                unsigned int timing_every=1):
     need_instance()
-    check(hal_thread_new(enc(name), period, uses_fp, timing_every))
+    cdef bytes b = enc(name)
+    cdef const char *cb = b
+    cdef int r
+    with nogil:
+        r = hal_thread_new(cb, period, uses_fp, timing_every)
+    check(r)
     return find("thread", name)
 
 

@@ -75,8 +75,10 @@ def connect(instance: Optional[str] = None, create: Optional[bool] = None,
     """Create or attach; ``create``: True must create, False must attach,
     None creates when there is no instance."""
     global _conn
-    shm = shm_name(instance)
     with _conn_lock:
+        # no name given: the instance this process already uses
+        shm = _conn.shm if instance is None and _conn is not None \
+            else shm_name(instance)
         if _conn is not None:
             if _conn.shm != shm:
                 raise InstanceError(

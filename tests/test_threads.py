@@ -275,3 +275,38 @@ def test_non_realtime_note_without_permission(tmp_path):
     assert "NOTE: Note: Using POSIX non-realtime" in proc.stdout
     cycles = int(proc.stdout.split("CYCLES:")[1])
     assert cycles > 10
+
+
+def test_no_deadlock_between_gil_mutex_and_python_functions(tmp_path):
+    """Deleting a thread that runs a Python function, while other Python
+    threads keep taking the instance mutex, must not deadlock: nobody
+    waits for the mutex with the GIL held."""
+    script = textwrap.dedent("""
+        import os, threading, time, halsdk
+        from halsdk import _core
+        h = halsdk.Hal(f"dl-{os.getpid()}", create=True, size=1 << 22)
+        stop = False
+        def busy():
+            while not stop:
+                _core.find("signal", "nothing")
+                c = halsdk.component("churn")
+                c.exit()
+        threading.Thread(target=busy, daemon=True).start()
+        for k in range(40):
+            h.newthread("t", 200_000)
+            h.add_python_function(f"f{k}", lambda p: None, thread="t")
+            h.start(False)
+            time.sleep(0.005)
+            h.delthread("t")
+        stop = True
+        print("done")
+        h.close()
+    """)
+    env = dict(os.environ)
+    env.pop("HALSDK_INSTANCE", None)
+    src = os.path.dirname(os.path.dirname(halsdk.__file__))
+    env["PYTHONPATH"] = src + os.pathsep + env.get("PYTHONPATH", "")
+    proc = subprocess.run([sys.executable, "-c", script], env=env,
+                          capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.strip() == "done"

@@ -107,12 +107,23 @@ int hal_pid_alive(int pid, uint64_t start)
 
 static void recover_after_dead_holder(void);
 
+void *(*hal_gil_release)(void);
+void (*hal_gil_restore)(void *);
+
 int hal_lock(void)
 {
     hal_header_t *h = hal_map.hdr;
     if (!h)
         return hal_fail(ENODEV, "no HAL instance is attached");
-    int r = pthread_mutex_lock(&h->mutex);
+    /* A holder may be waiting for a thread cycle that runs a Python
+       function: never wait for the mutex with the GIL held. */
+    int r = pthread_mutex_trylock(&h->mutex);
+    if (r == EBUSY) {
+        void *gil = hal_gil_release ? hal_gil_release() : NULL;
+        r = pthread_mutex_lock(&h->mutex);
+        if (gil)
+            hal_gil_restore(gil);
+    }
     if (r == EOWNERDEAD) {
         recover_after_dead_holder();
         pthread_mutex_consistent(&h->mutex);

@@ -211,6 +211,9 @@ int hal_pid_alive(int pid, uint64_t start);
 
 /* mutex */
 int hal_lock(void);
+/* set by the Python binding: drop and retake the GIL around a wait */
+extern void *(*hal_gil_release)(void);
+extern void (*hal_gil_restore)(void *);
 void hal_unlock(void);
 int hal_hold_lock_for_test(double seconds);
 
