@@ -1,19 +1,15 @@
 """Sphinx configuration of the halsdk documentation.
 
 Build: ``python -m sphinx -W --keep-going -b html docs docs/_build/html``.
-The API pages are made by autodoc, so :mod:`halsdk` (with its compiled core)
-must be importable: install the project (``pip install -e .``) first.
+The API pages are made by autodoc from the installed :mod:`halsdk` (with
+its compiled core): install the project first (``pip install .`` or
+``pip install -e .``).  The source tree is not put on the path, since
+without a build it holds no compiled core.
 """
 
 from __future__ import annotations
 
-import os
-import sys
-
-HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.dirname(HERE))      # the repository root
-
-import halsdk  # noqa: E402  (after the path change)
+import halsdk
 
 project = "halsdk"
 author = "the halsdk authors"

@@ -30,7 +30,7 @@ def site(tmp_path_factory: pytest.TempPathFactory) -> str:
     proc = subprocess.run(
         [sys.executable, "-m", "sphinx", "-W", "--keep-going", "-b", "html",
          "-d", str(out / ".doctrees"), DOCS, str(out)],
-        capture_output=True, text=True, cwd=ROOT)
+        capture_output=True, text=True, cwd=str(out))   # not the source tree
     assert proc.returncode == 0, (
         f"sphinx failed ({proc.returncode}):\n{proc.stdout[-3000:]}\n"
         f"{proc.stderr[-6000:]}")
