@@ -57,16 +57,23 @@ cdef extern from "hal_core.h" nogil:
         int32_t id
         hoff_t comp
 
+    ctypedef struct hal_item_t:
+        hal_obj_t o
+        hoff_t comp, inst, oldname
+        int16_t type, dir
+
     ctypedef struct hal_pin_t:
         hal_obj_t o
-        hoff_t comp, inst, ptr_cell, signal, oldname
+        hoff_t comp, inst, oldname
         int16_t type, dir
+        hoff_t ptr_cell, signal
         hal_value_t dummy
 
     ctypedef struct hal_param_t:
         hal_obj_t o
-        hoff_t comp, inst, data, oldname
+        hoff_t comp, inst, oldname
         int16_t type, dir
+        hoff_t data
 
     ctypedef struct hal_sig_t:
         hal_obj_t o
@@ -427,28 +434,84 @@ cdef str comp_name(hoff_t off):
     return (<hal_obj_t *>SHMPTR(off)).name.decode("utf-8", "replace")
 
 
-cdef class Pin(Item):
-    """A pin: a typed endpoint of a component."""
+cdef class ValueItem(Item):
+    """What pins and params share: owner, type, direction, alias, value."""
+
+    cdef void *data(self) except NULL:
+        raise NotImplementedError
+
+    cdef int check_setp(self, hal_item_t *it) except -1:
+        raise NotImplementedError
 
     @property
     def type(self) -> int:
         """HAL type number (see :class:`halsdk.HalType`)."""
-        return (<hal_pin_t *>self.rec()).type
+        return (<hal_item_t *>self.rec()).type
 
     @property
     def direction(self) -> int:
         """Direction number (see :class:`halsdk.Direction`)."""
-        return (<hal_pin_t *>self.rec()).dir
+        return (<hal_item_t *>self.rec()).dir
 
     @property
     def owner(self) -> str:
         """Name of the owning component."""
-        return comp_name((<hal_pin_t *>self.rec()).comp)
+        return comp_name((<hal_item_t *>self.rec()).comp)
 
     @property
     def owner_id(self) -> int:
         """Id of the owning component."""
-        return (<hal_comp_t *>SHMPTR((<hal_pin_t *>self.rec()).comp)).id
+        return (<hal_comp_t *>SHMPTR((<hal_item_t *>self.rec()).comp)).id
+
+    @property
+    def alias_of(self):
+        """The original name while the item has an alias, else None."""
+        cdef hal_item_t *it = <hal_item_t *>self.rec()
+        if it.oldname == 0:
+            return None
+        return (<char *>SHMPTR(it.oldname)).decode("utf-8", "replace")
+
+    @property
+    def value(self):
+        return get_raw((<hal_item_t *>self.rec()).type, self.data())
+
+    @value.setter
+    def value(self, v):
+        self.setp(v)
+
+    def setp(self, v):
+        """Set the value as ``halcmd setp`` does (it refuses out pins,
+        linked pins and read-only params)."""
+        cdef hal_item_t *it = <hal_item_t *>self.rec()
+        if hal_map.hdr.lock & HAL_LOCK_PARAMS:
+            raise _errors.NotPermittedError(
+                f"cannot set {KIND_WORDS[self.kind]} '{self._name}': HAL is "
+                "locked against setting values")
+        self.check_setp(it)
+        v = parse_value(it.type, v, f"{KIND_WORDS[self.kind]} '{self._name}'")
+        put_raw(it.type, self.data(), v)
+
+    def write(self, v):
+        """Write the value as the owning component does (any direction)."""
+        cdef hal_item_t *it = <hal_item_t *>self.rec()
+        v = parse_value(it.type, v, f"{KIND_WORDS[self.kind]} '{self._name}'")
+        put_raw(it.type, self.data(), v)
+
+
+cdef class Pin(ValueItem):
+    """A pin: a typed endpoint of a component."""
+
+    cdef void *data(self) except NULL:
+        return hal_pin_value(<hal_pin_t *>self.rec())
+
+    cdef int check_setp(self, hal_item_t *it) except -1:
+        if it.dir == HALSDK_OUT:
+            raise _errors.NotPermittedError(
+                f"pin '{self._name}' is not writable")
+        if (<hal_pin_t *>it).signal != 0:
+            raise _errors.ConflictError(
+                f"pin '{self._name}' is connected to a signal")
+        return 0
 
     @property
     def signal(self):
@@ -463,103 +526,18 @@ cdef class Pin(Item):
         """True while linked to a signal."""
         return (<hal_pin_t *>self.rec()).signal != 0
 
-    @property
-    def alias_of(self):
-        """The original name while the pin has an alias, else None."""
-        cdef hal_pin_t *p = <hal_pin_t *>self.rec()
-        if p.oldname == 0:
-            return None
-        return (<char *>SHMPTR(p.oldname)).decode("utf-8", "replace")
 
-    @property
-    def value(self):
-        cdef hal_pin_t *p = <hal_pin_t *>self.rec()
-        return get_raw(p.type, hal_pin_value(p))
-
-    @value.setter
-    def value(self, v):
-        self.setp(v)
-
-    def setp(self, v):
-        """Set the pin as ``halcmd setp`` does: an unlinked in or io pin."""
-        cdef hal_pin_t *p = <hal_pin_t *>self.rec()
-        if hal_map.hdr.lock & HAL_LOCK_PARAMS:
-            raise _errors.NotPermittedError(
-                f"cannot set pin '{self._name}': HAL is locked against "
-                "setting values")
-        if p.dir == HALSDK_OUT:
-            raise _errors.NotPermittedError(
-                f"pin '{self._name}' is not writable")
-        if p.signal != 0:
-            raise _errors.ConflictError(
-                f"pin '{self._name}' is connected to a signal")
-        v = parse_value(p.type, v, f"pin '{self._name}'")
-        put_raw(p.type, hal_pin_value(p), v)
-
-    def write(self, v):
-        """Write the value as the owning component does (any direction)."""
-        cdef hal_pin_t *p = <hal_pin_t *>self.rec()
-        v = parse_value(p.type, v, f"pin '{self._name}'")
-        put_raw(p.type, hal_pin_value(p), v)
-
-
-cdef class Param(Item):
+cdef class Param(ValueItem):
     """A parameter of a component."""
 
-    @property
-    def type(self) -> int:
-        """HAL type number (see :class:`halsdk.HalType`)."""
-        return (<hal_param_t *>self.rec()).type
+    cdef void *data(self) except NULL:
+        return hal_param_value(<hal_param_t *>self.rec())
 
-    @property
-    def direction(self) -> int:
-        """Direction number (see :class:`halsdk.Direction`)."""
-        return (<hal_param_t *>self.rec()).dir
-
-    @property
-    def owner(self) -> str:
-        """Name of the owning component."""
-        return comp_name((<hal_param_t *>self.rec()).comp)
-
-    @property
-    def owner_id(self) -> int:
-        """Id of the owning component."""
-        return (<hal_comp_t *>SHMPTR((<hal_param_t *>self.rec()).comp)).id
-
-    @property
-    def alias_of(self):
-        cdef hal_param_t *p = <hal_param_t *>self.rec()
-        if p.oldname == 0:
-            return None
-        return (<char *>SHMPTR(p.oldname)).decode("utf-8", "replace")
-
-    @property
-    def value(self):
-        cdef hal_param_t *p = <hal_param_t *>self.rec()
-        return get_raw(p.type, hal_param_value(p))
-
-    @value.setter
-    def value(self, v):
-        self.setp(v)
-
-    def setp(self, v):
-        """Set the param as ``halcmd setp`` does: RW params only."""
-        cdef hal_param_t *p = <hal_param_t *>self.rec()
-        if hal_map.hdr.lock & HAL_LOCK_PARAMS:
-            raise _errors.NotPermittedError(
-                f"cannot set param '{self._name}': HAL is locked against "
-                "setting values")
-        if p.dir == HALSDK_RO:
+    cdef int check_setp(self, hal_item_t *it) except -1:
+        if it.dir == HALSDK_RO:
             raise _errors.NotPermittedError(
                 f"param '{self._name}' is not writable")
-        v = parse_value(p.type, v, f"param '{self._name}'")
-        put_raw(p.type, hal_param_value(p), v)
-
-    def write(self, v):
-        """Write the value as the owning component does (RO too)."""
-        cdef hal_param_t *p = <hal_param_t *>self.rec()
-        v = parse_value(p.type, v, f"param '{self._name}'")
-        put_raw(p.type, hal_param_value(p), v)
+        return 0
 
 
 cdef class Signal(Item):

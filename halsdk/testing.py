@@ -54,22 +54,16 @@ class TestHal(halsdk.Hal):
         """Set inputs: unlinked in-pins and params (setp), or signals
         without a writer (sets)."""
         for name, value in values.items():
-            item = self._input(name)
+            item = self._lookup(name)
             if isinstance(item, _core.Signal):
                 item.sets(value)
             else:
                 item.setp(value)
 
-    def _input(self, name: str):
-        item = (_core.find("param", name) or _core.find("pin", name)
+    def _lookup(self, name: str):
+        """The pin or param of that name, else the signal."""
+        item = (_core.find("pin", name) or _core.find("param", name)
                 or _core.find("signal", name))
-        if item is None:
-            raise halsdk.NotFoundError(f"no pin, param or signal '{name}'")
-        return item
-
-    def _source(self, name: str):
-        item = (_core.find("pin", name) or _core.find("signal", name)
-                or _core.find("param", name))
         if item is None:
             raise halsdk.NotFoundError(f"no pin, param or signal '{name}'")
         return item
@@ -82,10 +76,10 @@ class TestHal(halsdk.Hal):
         a sequence giving one value per cycle), after each cycle sample
         the ``record`` names (pins, signals or params)."""
         inputs = dict(inputs or {})
-        sources = [(n, self._source(n)) for n in record]
+        sources = [(n, self._lookup(n)) for n in record]
         plan = []
         for name, value in inputs.items():
-            target = self._input(name)
+            target = self._lookup(name)
             if isinstance(value, (str, bytes)) or not isinstance(
                     value, (Sequence, np.ndarray)):
                 self.set({name: value})

@@ -615,89 +615,76 @@ void *hal_param_value(hal_param_t *param)
     return SHMPTR(param->data);
 }
 
-int hal_pin_new(const char *name, int type, int dir, void **ptr_cell,
-                int owner_id)
+/* the record of a pin or param, published; lock held.  `where` is the
+   pin's pointer cell or the param's value */
+static hal_item_t *item_make(int kind, const char *name, int type, int dir,
+                             hal_comp_t *c, hal_inst_t *i, void *where)
 {
-    int r = hal_check_name(name, "pin");
+    hal_item_t *it = obj_new(kind, kind == K_PIN ? sizeof(hal_pin_t)
+                                                 : sizeof(hal_param_t), name);
+    if (!it)
+        return NULL;
+    it->type = (int16_t)type;
+    it->dir = (int16_t)dir;
+    it->comp = SHMOFF(c);
+    it->inst = i ? SHMOFF(i) : 0;
+    if (kind == K_PIN) {
+        hal_pin_t *p = (hal_pin_t *)it;
+        p->ptr_cell = SHMOFF(where);
+        write_cell(p, &p->dummy);
+    } else {
+        ((hal_param_t *)it)->data = SHMOFF(where);
+    }
+    obj_publish(&it->o);
+    return it;
+}
+
+/* hal_pin_new and hal_param_new: every check, then the record */
+static int item_add(int kind, const char *name, int type, int dir,
+                    volatile void *where, int owner_id)
+{
+    const char *what = kind == K_PIN ? "pin" : "param";
+    int r = hal_check_name(name, what);
     if (r)
         return r;
     if (!type_size(type))
-        return hal_fail(EINVAL, "pin '%s': bad type %d", name, type);
-    if (dir != HALSDK_IN && dir != HALSDK_OUT && dir != HALSDK_IO)
-        return hal_fail(EINVAL, "pin '%s': bad direction %d", name, dir);
+        return hal_fail(EINVAL, "%s '%s': bad type %d", what, name, type);
+    if (kind == K_PIN ? dir != HALSDK_IN && dir != HALSDK_OUT &&
+                        dir != HALSDK_IO
+                      : dir != HALSDK_RO && dir != HALSDK_RW)
+        return hal_fail(EINVAL, "%s '%s': bad direction %d", what, name,
+                        dir);
     if (!hal_map.hdr)
         return hal_fail(ENODEV, "no HAL instance is attached");
-    if (!in_segment(ptr_cell, sizeof(void *)))
-        return hal_fail(EINVAL, "pin '%s': data_ptr_addr is not in HAL "
-                        "shared memory (allocate it with hal_malloc)",
-                        name);
+    if (!in_segment(where, kind == K_PIN ? (long)sizeof(void *)
+                                         : type_size(type)))
+        return hal_fail(EINVAL, "%s '%s': %s is not in HAL shared memory "
+                        "(allocate it with hal_malloc)", what, name,
+                        kind == K_PIN ? "data_ptr_addr" : "data_addr");
     if ((r = hal_lock()))
         return r;
     hal_comp_t *c;
     hal_inst_t *i;
-    if ((r = resolve_owner(owner_id, &c, &i, "pin", name)))
-        goto out;
-    if (find_in_space(K_PIN, name)) {
-        r = hal_fail(EEXIST, "duplicate pin or param name '%s'", name);
-        goto out;
+    if (!(r = resolve_owner(owner_id, &c, &i, what, name))) {
+        if (find_in_space(K_PIN, name))
+            r = hal_fail(EEXIST, "duplicate pin or param name '%s'", name);
+        else if (!item_make(kind, name, type, dir, c, i, (void *)where))
+            r = -ENOMEM;
     }
-    hal_pin_t *p = obj_new(K_PIN, sizeof(*p), name);
-    if (!p) {
-        r = -ENOMEM;
-        goto out;
-    }
-    p->type = (int16_t)type;
-    p->dir = (int16_t)dir;
-    p->comp = SHMOFF(c);
-    p->inst = i ? SHMOFF(i) : 0;
-    p->ptr_cell = SHMOFF(ptr_cell);
-    write_cell(p, &p->dummy);
-    obj_publish(&p->o);
-out:
     hal_unlock();
     return r;
+}
+
+int hal_pin_new(const char *name, int type, int dir, void **ptr_cell,
+                int owner_id)
+{
+    return item_add(K_PIN, name, type, dir, ptr_cell, owner_id);
 }
 
 int hal_param_new(const char *name, int type, int dir, volatile void *data,
                   int owner_id)
 {
-    int r = hal_check_name(name, "param");
-    if (r)
-        return r;
-    if (!type_size(type))
-        return hal_fail(EINVAL, "param '%s': bad type %d", name, type);
-    if (dir != HALSDK_RO && dir != HALSDK_RW)
-        return hal_fail(EINVAL, "param '%s': bad direction %d", name, dir);
-    if (!hal_map.hdr)
-        return hal_fail(ENODEV, "no HAL instance is attached");
-    if (!in_segment(data, type_size(type)))
-        return hal_fail(EINVAL, "param '%s': data_addr is not in HAL "
-                        "shared memory (allocate it with hal_malloc)",
-                        name);
-    if ((r = hal_lock()))
-        return r;
-    hal_comp_t *c;
-    hal_inst_t *i;
-    if ((r = resolve_owner(owner_id, &c, &i, "param", name)))
-        goto out;
-    if (find_in_space(K_PIN, name)) {
-        r = hal_fail(EEXIST, "duplicate pin or param name '%s'", name);
-        goto out;
-    }
-    hal_param_t *p = obj_new(K_PARAM, sizeof(*p), name);
-    if (!p) {
-        r = -ENOMEM;
-        goto out;
-    }
-    p->type = (int16_t)type;
-    p->dir = (int16_t)dir;
-    p->comp = SHMOFF(c);
-    p->inst = i ? SHMOFF(i) : 0;
-    p->data = SHMOFF(data);
-    obj_publish(&p->o);
-out:
-    hal_unlock();
-    return r;
+    return item_add(K_PARAM, name, type, dir, data, owner_id);
 }
 
 /* rename a pin or param; its original name is kept for unalias */
@@ -914,21 +901,14 @@ int hal_unlink(const char *pin_name)
 /* ---------------------------------------------------------------- */
 /* functions and threads                                            */
 
+/* a core-made pin or param (function and thread timing): its cell or
+   value belongs to the owner; lock held */
 static hal_pin_t *item_pin_new(const char *name, int type, int dir,
                                hal_comp_t *c, hal_inst_t *i, hoff_t owner)
 {
-    void **cell = alloc_for(owner, sizeof(void *));
-    hal_pin_t *p = cell ? obj_new(K_PIN, sizeof(*p), name) : NULL;
-    if (!p)
-        return NULL;
-    p->type = (int16_t)type;
-    p->dir = (int16_t)dir;
-    p->comp = SHMOFF(c);
-    p->inst = i ? SHMOFF(i) : 0;
-    p->ptr_cell = SHMOFF(cell);
-    write_cell(p, &p->dummy);
-    obj_publish(&p->o);
-    return p;
+    void *cell = alloc_for(owner, sizeof(void *));
+    return cell ? (hal_pin_t *)item_make(K_PIN, name, type, dir, c, i, cell)
+                : NULL;
 }
 
 static hal_param_t *item_param_new(const char *name, int type, int dir,
@@ -936,16 +916,9 @@ static hal_param_t *item_param_new(const char *name, int type, int dir,
                                    hoff_t owner)
 {
     void *data = alloc_for(owner, 8);
-    hal_param_t *p = data ? obj_new(K_PARAM, sizeof(*p), name) : NULL;
-    if (!p)
-        return NULL;
-    p->type = (int16_t)type;
-    p->dir = (int16_t)dir;
-    p->comp = SHMOFF(c);
-    p->inst = i ? SHMOFF(i) : 0;
-    p->data = SHMOFF(data);
-    obj_publish(&p->o);
-    return p;
+    return data ? (hal_param_t *)item_make(K_PARAM, name, type, dir, c, i,
+                                           data)
+                : NULL;
 }
 
 static int names_free(const char *base, const char *const *suffixes)

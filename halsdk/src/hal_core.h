@@ -80,22 +80,28 @@ typedef struct {
     hoff_t mem;
 } hal_inst_t;
 
+/* pins and params begin alike (hal_item_t), so that code reading their
+   owner, type or alias can treat them as one */
+#define HAL_ITEM_HEAD                                                     \
+    hal_obj_t o;                                                          \
+    hoff_t comp, inst;                                                    \
+    hoff_t oldname;             /* original name while aliased */         \
+    int16_t type, dir
+
 typedef struct {
-    hal_obj_t o;
-    hoff_t comp, inst;
+    HAL_ITEM_HEAD;
+} hal_item_t;
+
+typedef struct {
+    HAL_ITEM_HEAD;
     hoff_t ptr_cell;            /* where the owner's pointer to data lives */
     hoff_t signal;
-    hoff_t oldname;             /* original name while aliased */
-    int16_t type, dir;
     hal_value_t dummy;          /* the value while unlinked */
 } hal_pin_t;
 
 typedef struct {
-    hal_obj_t o;
-    hoff_t comp, inst;
+    HAL_ITEM_HEAD;
     hoff_t data;
-    hoff_t oldname;
-    int16_t type, dir;
 } hal_param_t;
 
 typedef struct {
