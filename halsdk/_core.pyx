@@ -795,18 +795,16 @@ def detach(bint unlink=False, shm_name=None):
 
 
 def probe(str shm_name):
-    """(host_pid, host_start, abi) of an instance, or None if absent.
-
-    Raises InstanceError for a segment that is not a halsdk instance.
-    """
+    """What is at a shared-memory name, as ``(state, host_pid, host_start,
+    abi)``; state is ``"absent"``, ``"creating"`` (being created),
+    ``"junk"`` (not a halsdk instance), ``"abi"`` (an instance of another
+    ABI version) or ``"ok"``."""
     cdef int pid = 0, abi = 0
     cdef uint64_t start = 0
     r = hal_instance_probe(enc(shm_name), &pid, &start, &abi)
-    if r == -2:
-        return None
-    if r < 0:
-        raise _errors.InstanceError(f"{shm_name} is not a halsdk instance")
-    return pid, start, abi
+    state = {0: "ok", -2: "absent", -11: "creating", -71: "junk",
+             -93: "abi"}.get(r, "junk")
+    return state, pid, start, abi
 
 
 def pid_alive(int pid, uint64_t start=0) -> bool:

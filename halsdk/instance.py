@@ -12,10 +12,11 @@ import os
 import re
 import signal
 import threading
+import time
 from typing import Callable, Optional
 
 from halsdk import _core
-from halsdk.errors import InstanceError, InvalidError
+from halsdk.errors import ExistsError, InstanceError, InvalidError
 
 _INSTANCE_NAME = re.compile(r"^[A-Za-z0-9_.-]{1,40}$")
 SHM_DIR = "/dev/shm"
@@ -90,28 +91,7 @@ def connect(instance: Optional[str] = None, create: Optional[bool] = None,
                     "is attached to it, not its host")
             _conn.users += 1
             return _conn
-        found = _core.probe(shm)
-        if found is not None:
-            pid, start, abi = found
-            if not _core.pid_alive(pid, start):
-                raise InstanceError(
-                    f"HAL instance '{instance_label(shm)}' was left by a "
-                    f"host (pid {pid}) that is gone; remove it with "
-                    "halsdk.cleanup() or 'halrun -U'")
-            if create:
-                raise InstanceError(
-                    f"HAL instance '{instance_label(shm)}' already has a "
-                    f"host (pid {pid})")
-            _core.attach(shm)
-            conn = Connection(shm, host=False)
-        else:
-            if create is False:
-                raise InstanceError(
-                    f"no HAL instance '{instance_label(shm)}' is running "
-                    "(start one with halrun or halsdk.Hal())")
-            _core.create(shm, instance_label(shm), size or 0)
-            conn = Connection(shm, host=True)
-            _install_sigterm()
+        conn = _attach_or_create(shm, create, size)
         conn.users = 1
         _conn = conn
         if conn.host:
@@ -122,6 +102,56 @@ def connect(instance: Optional[str] = None, create: Optional[bool] = None,
                 _teardown(conn)
                 raise
         return conn
+
+
+def _probe_settled(shm: str) -> tuple:
+    """Probe, waiting up to a second for an instance being created."""
+    deadline = time.monotonic() + 1.0
+    while True:
+        found = _core.probe(shm)
+        if found[0] != "creating" or time.monotonic() > deadline:
+            return found
+        time.sleep(0.01)
+
+
+def _attach_or_create(shm: str, create: Optional[bool],
+                      size: Optional[int]) -> Connection:
+    label = instance_label(shm)
+    for _attempt in range(2):
+        state, pid, start, abi = _probe_settled(shm)
+        if state == "junk":
+            raise InstanceError(f"{SHM_DIR}{shm} is not a halsdk instance; "
+                                "remove it by hand")
+        if state == "abi":
+            raise InstanceError(
+                f"HAL instance '{label}' ({SHM_DIR}{shm}) has ABI version "
+                f"{abi}; this halsdk speaks version {_core.ABI_VERSION}")
+        if state == "creating":
+            raise InstanceError(
+                f"HAL instance '{label}' is still being created, or was left "
+                "half-made; try again, or remove it with halsdk.cleanup()")
+        if state == "ok":
+            if not _core.pid_alive(pid, start):
+                raise InstanceError(
+                    f"HAL instance '{label}' was left by a host (pid {pid}) "
+                    "that is gone; remove it with halsdk.cleanup() or "
+                    "'halrun -U'")
+            if create:
+                raise InstanceError(f"HAL instance '{label}' already has a "
+                                    f"host (pid {pid})")
+            _core.attach(shm)
+            return Connection(shm, host=False)
+        if create is False:
+            raise InstanceError(f"no HAL instance '{label}' is running "
+                                "(start one with halrun or halsdk.Hal())")
+        try:
+            _core.create(shm, label, size or 0)
+        except ExistsError:
+            continue            # another process created it meanwhile
+        _install_sigterm()
+        return Connection(shm, host=True)
+    raise InstanceError(f"HAL instance '{label}' appeared while it was "
+                        "being created here; try again")
 
 
 def release(conn: Connection) -> None:
@@ -180,6 +210,14 @@ def _install_sigterm() -> None:
         signal.signal(signal.SIGTERM, on_term)
 
 
+def _older_than(name: str, seconds: float) -> bool:
+    try:
+        st = os.stat(os.path.join(SHM_DIR, name))
+    except FileNotFoundError:
+        return False
+    return time.time() - st.st_mtime > seconds
+
+
 def cleanup(instance: Optional[str] = None) -> list[str]:
     """Remove instances of this user whose host process is gone.
 
@@ -203,15 +241,13 @@ def cleanup(instance: Optional[str] = None) -> list[str]:
         shm = "/" + n
         if _conn is not None and _conn.shm == shm:
             continue
-        try:
-            found = _core.probe(shm)
-        except InstanceError:
-            found = (0, 0, 0)           # not an instance: junk of ours
-        if found is None:
+        state, pid, start, _abi = _core.probe(shm)
+        if state in ("absent", "abi"):
+            continue            # another version's instance is not ours
+        if state == "ok" and _core.pid_alive(pid, start):
             continue
-        pid, start, _abi = found
-        if pid and _core.pid_alive(pid, start):
-            continue
+        if state in ("creating", "junk") and not _older_than(n, 10.0):
+            continue            # perhaps being created right now
         try:
             os.unlink(os.path.join(SHM_DIR, n))
             removed.append(n)

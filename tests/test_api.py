@@ -130,3 +130,26 @@ def test_instance_info_counts(hal):
     assert info["bytes_used"] > 0
     assert info["instance"] == hal.instance
     assert _core.serial() > 0
+
+
+def test_half_made_segment_is_waited_for_and_cleaned_only_when_old():
+    name = halsdk.testing.private_instance_name()
+    shm = halsdk.instance.shm_name(name)
+    path = "/dev/shm" + shm
+    fd = os.open(path, os.O_CREAT | os.O_WRONLY, 0o600)   # empty: "creating"
+    os.close(fd)
+    try:
+        with pytest.raises(halsdk.InstanceError, match="being created"):
+            halsdk.Hal(name, create=False)
+        assert n_removed(halsdk.cleanup(name)) == 0       # may be in progress
+        old = os.stat(path).st_mtime - 60
+        os.utime(path, (old, old))
+        assert n_removed(halsdk.cleanup(name)) == 1       # left half-made
+        assert not os.path.exists(path)
+    finally:
+        if os.path.exists(path):
+            os.unlink(path)
+
+
+def n_removed(names: list) -> int:
+    return len(names)

@@ -1533,6 +1533,13 @@ int hal_instance_create(const char *shm_name, const char *instance,
     return 0;
 }
 
+/*
+ * What is at shm_name: 0 an instance of this ABI (host filled in),
+ * -ENOENT nothing, -EAGAIN one being created (short, or magic not yet
+ * written), -EPROTO not a halsdk instance, -EPROTONOSUPPORT an instance of
+ * another ABI (*abi set).  The magic and the ABI are the first fields of
+ * every version's header, so they are read before anything else.
+ */
 int hal_instance_probe(const char *shm_name, int *host_pid,
                        uint64_t *host_start, int *abi)
 {
@@ -1540,15 +1547,23 @@ int hal_instance_probe(const char *shm_name, int *host_pid,
     if (fd < 0)
         return -errno;
     hal_header_t h;
+    memset(&h, 0, sizeof(h));
     ssize_t n = pread(fd, &h, sizeof(h), 0);
     close(fd);
-    if (n < (ssize_t)offsetof(hal_header_t, mutex))
-        return -EPROTO;
+    *host_pid = 0;
+    *host_start = 0;
+    *abi = 0;
+    if (n < (ssize_t)(sizeof(h.magic) + sizeof(h.abi)) || h.magic == 0)
+        return -EAGAIN;
     if (h.magic != HAL_MAGIC)
         return -EPROTO;
+    *abi = (int)h.abi;
+    if (h.abi != HAL_ABI_VERSION)
+        return -EPROTONOSUPPORT;
+    if (n < (ssize_t)sizeof(h))
+        return -EAGAIN;
     *host_pid = h.host_pid;
     *host_start = h.host_start;
-    *abi = (int)h.abi;
     return 0;
 }
 
