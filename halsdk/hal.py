@@ -131,22 +131,21 @@ class Hal:
         self._call_host("unload", name, timeout)
 
     def _host_unload(self, name: str, timeout: float = 5.0) -> None:
+        registry = self._conn.registry
         with self._conn.lock:
-            registry = self._conn.registry
             if name == "all":
                 registry.unload_all()
-                for comp in _core.items("component"):
-                    if comp.exists and not comp.name.startswith("__"):
-                        self._remove_user_comp(comp.name, timeout)
-                return
-            loaded = registry.module_of_comp(name)
-            if loaded is not None:
-                registry.unload(loaded.name)
-                return
-            if name in registry.modules:
-                registry.unload(name)
-                return
-            self._remove_user_comp(name, timeout)
+                users = [c.name for c in _core.items("component")
+                         if c.exists and not c.name.startswith("__")]
+            else:
+                loaded = registry.module_of_comp(name)
+                if loaded is not None or name in registry.modules:
+                    registry.unload(loaded.name if loaded else name)
+                    return
+                users = [name]
+        # waiting for a process to exit must not block other requests
+        for comp in users:
+            self._remove_user_comp(comp, timeout)
 
     def _remove_user_comp(self, name: str, timeout: float) -> None:
         comp = _core.find("component", name)
