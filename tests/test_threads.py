@@ -307,6 +307,7 @@ def test_no_deadlock_between_gil_mutex_and_python_functions(tmp_path):
     src = os.path.dirname(os.path.dirname(halsdk.__file__))
     env["PYTHONPATH"] = src + os.pathsep + env.get("PYTHONPATH", "")
     proc = subprocess.run([sys.executable, "-c", script], env=env,
-                          capture_output=True, text=True, timeout=120)
+                          capture_output=True, text=True, timeout=120,
+                          cwd=tmp_path)     # not the source tree
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.strip() == "done"
