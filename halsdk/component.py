@@ -65,7 +65,8 @@ class Component:
 
     @property
     def is_ready(self) -> bool:
-        return _core.comp_by_id(self.id).ready
+        """False once removed, or before :meth:`ready`."""
+        return self.exists and _core.comp_by_id(self.id).ready
 
     def item(self, name: str):
         try:
