@@ -87,6 +87,12 @@ class Server:
         if self.stopping:
             return
         self.stopping = True
+        try:                    # wake accept() now rather than at its timeout
+            with socket.socket(socket.AF_UNIX, socket.SOCK_STREAM) as poke:
+                poke.settimeout(1)
+                poke.connect(self.path)
+        except OSError:
+            pass
         if threading.current_thread() is not self.thread:
             self.thread.join(timeout=5)
         self.sock.close()
