@@ -1,0 +1,22 @@
+"""Compatibility layers for programs written for LinuxCNC.
+
+:mod:`halsdk.compat.hal` implements the documented API of LinuxCNC's
+Python ``hal`` module on top of halsdk, so that userspace components
+written for LinuxCNC run unchanged.  To let such a program keep its
+``import hal``, put :func:`pythonpath` on ``PYTHONPATH``::
+
+    PYTHONPATH=$(python -c 'import halsdk.compat as c; print(c.pythonpath())') \\
+        python3 mycomponent.py
+"""
+
+from __future__ import annotations
+
+import os
+
+__all__ = ["pythonpath"]
+
+
+def pythonpath() -> str:
+    """The folder holding a ``hal`` module that stands for
+    :mod:`halsdk.compat.hal` (put it on ``PYTHONPATH``)."""
+    return os.path.join(os.path.dirname(os.path.abspath(__file__)), "pypath")
