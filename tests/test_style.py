@@ -1,0 +1,18 @@
+"""The Python code of the repository is ruff clean (PEP 8 and more)."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def test_ruff_clean():
+    ruff = shutil.which("ruff")
+    assert ruff, "ruff is part of the test extras: pip install '.[test]'"
+    proc = subprocess.run([ruff, "check", "--no-cache", "halsdk", "tests",
+                           "bench", "docs", "setup.py"],
+                          cwd=ROOT, capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
