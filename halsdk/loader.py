@@ -189,8 +189,12 @@ class Registry:
         self.modules: dict[str, Loaded] = {}
 
     def _own_comp_ids(self) -> set[int]:
+        """Components of this process, except those of threads (a module
+        that creates threads does not own them)."""
         pid = os.getpid()
-        return {c.id for c in _core.items("component") if c.pid == pid}
+        threads = {"__" + t.name for t in _core.items("thread")}
+        return {c.id for c in _core.items("component")
+                if c.pid == pid and c.name not in threads}
 
     def load(self, name: str, *args: Any, **kwargs: Any) -> list[str]:
         if name in self.modules:

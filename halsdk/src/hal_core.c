@@ -1313,6 +1313,13 @@ int hal_comp_exit(int id)
         return hal_fail(EINVAL, "no component with id %d", id);
     }
     hoff_t co = SHMOFF(c);
+    FOR_EACH(K_THREAD, hal_thread_t, t)
+        if (t->comp == co) {
+            hal_unlock();
+            return hal_fail(EPERM, "component '%s' belongs to thread '%s'; "
+                            "delete the thread instead", c->o.name,
+                            t->o.name);
+        }
     delete_items_of(co, 0);
     FOR_EACH(K_INST, hal_inst_t, i)
         if (i->comp == co) {
