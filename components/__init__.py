@@ -1,0 +1,1 @@
+"""The components that ship with halsdk (``loadrt NAME`` finds them here)."""
