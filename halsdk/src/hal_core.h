@@ -257,9 +257,7 @@ int hal_thread_new(const char *name, long period, int uses_fp,
 int hal_thread_delete(const char *name);
 int hal_addf(const char *funct, const char *thread, int position);
 int hal_delf(const char *funct, const char *thread);
-int hal_start_threads(void);
 int hal_stop_threads(void);
-int hal_step(const char *thread, long cycles);
 int hal_set_lock(unsigned char lock);
 int hal_check_consistency(char *report, int len);
 

@@ -330,7 +330,8 @@ int exec_start(int slot, int want_rt, char *note, int notelen)
     return 0;
 }
 
-int hal_start_threads(void)
+/* may the threads start now? */
+static int start_allowed(void)
 {
     if (!hal_map.is_host)
         return hal_fail(EPERM, "only the host process starts threads");
@@ -356,10 +357,9 @@ int hal_stop_threads(void)
 /* start every thread, faster threads at higher priority */
 int exec_start_all(int want_rt, char *note, int notelen)
 {
-    int r = hal_start_threads();
+    int r = start_allowed();
     if (r)
         return r;
-    int mlocked = 0;
     for (int s = 0; s < HAL_MAX_THREADS; s++) {
         executor_t *x = &execs[s];
         if (!x->used)
@@ -369,9 +369,9 @@ int exec_start_all(int want_rt, char *note, int notelen)
             faster += execs[o].used && execs[o].period < x->period;
         x->t->priority = 90 - faster > 1 ? 90 - faster : 1;
     }
+    /* best effort: without the privilege the threads run all the same */
     if (want_rt && getenv("HALSDK_NO_MLOCK") == NULL)
-        mlocked = mlockall(MCL_CURRENT | MCL_FUTURE) == 0;
-    (void)mlocked;
+        mlockall(MCL_CURRENT | MCL_FUTURE);
     for (int s = 0; s < HAL_MAX_THREADS; s++) {
         if (!execs[s].used)
             continue;
