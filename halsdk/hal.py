@@ -354,9 +354,10 @@ class Hal:
             if pin is None:
                 raise NotFoundError(f"pin '{name}' not found")
             handles.append(pin)
+        if _core.find("pin", signal) is not None:
+            raise InvalidError(f"Signal name '{signal}' must not be the same "
+                               "as a pin.  Did you omit the signal name?")
         sig = _core.find("signal", signal)
-        if sig is not None and _core.find("pin", signal) is not None:
-            raise ConflictError(f"'{signal}' is both a signal and a pin")
         stype = sig.type if sig is not None else handles[0].type
         writers = sig.writers if sig is not None else 0
         bidirs = sig.bidirs if sig is not None else 0

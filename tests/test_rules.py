@@ -200,6 +200,14 @@ def test_net_checks_everything_before_changing_anything(hal, comp):
     assert not hal.pin("uc.i").linked and not hal.pin("uc.o1").linked
 
 
+def test_net_refuses_a_pin_name_as_signal_name(hal, comp):
+    comp.newpin("o", "bit", "out")
+    comp.newpin("i", "bit", "in")
+    with pytest.raises(halsdk.InvalidError, match="omit the signal name"):
+        hal.net("uc.o", "uc.i")
+    assert hal.signals() == [] and not hal.pin("uc.i").linked
+
+
 def test_linking_across_types_is_refused(hal, comp):
     comp.newpin("f", "float", "in")
     comp.newpin("b", "bit", "in")
