@@ -194,3 +194,11 @@ def test_component_from_entry_point_group(hal, tmp_path, monkeypatch):
     assert "tpy" in _core_items
     hal.unloadrt("tpy")
     assert _core.find("component", "tpy") is None
+
+
+@pytest.mark.parametrize("text,value", [("10", 10), ("0x1f", 31),
+                                        ("010", 8), ("-0x10", -16),
+                                        ("0", 0), ("+7", 7)])
+def test_load_line_integers_read_as_c_does(text, value):
+    from halsdk.loader import c_integer
+    assert c_integer(text) == value
