@@ -61,7 +61,8 @@ def remove_socket(shm: str) -> None:
 
 
 class Server:
-    """Serves requests on the host, one at a time, in a daemon thread."""
+    """Serves requests on the host: a daemon thread accepts connections and
+    each connection is served by a thread of its own."""
 
     def __init__(self, conn):
         self.conn = conn
@@ -107,12 +108,21 @@ class Server:
                 client, _ = self.sock.accept()
             except (socket.timeout, OSError):
                 continue
-            with client:
-                client.settimeout(30)
-                try:
-                    self._handle(client)
-                except (OSError, ValueError):
-                    pass
+            if self.stopping:
+                client.close()
+                break
+            # one thread per connection: a slow or idle client does not
+            # hold up the others (host operations serialize themselves)
+            threading.Thread(target=self._client, args=(client,),
+                             name="halsdk-request", daemon=True).start()
+
+    def _client(self, client: socket.socket) -> None:
+        with client:
+            client.settimeout(30)
+            try:
+                self._handle(client)
+            except (OSError, ValueError):
+                pass
 
     def _handle(self, client: socket.socket) -> None:
         creds = client.getsockopt(socket.SOL_SOCKET, socket.SO_PEERCRED,

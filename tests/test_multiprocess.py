@@ -777,3 +777,20 @@ def test_segment_and_channel_permissions(hal):
 
     # it is the live channel of this host
     assert channel.request(shm, "ping") == os.getpid()
+
+
+def test_idle_client_does_not_block_other_requests(hal):
+    """A client that connects and says nothing must not hold up others."""
+    import socket as _socket
+    import time as _time
+
+    from halsdk import channel
+    shm = halsdk.instance.shm_name(hal.instance)
+    idle = _socket.socket(_socket.AF_UNIX, _socket.SOCK_STREAM)
+    idle.connect(channel.socket_path(shm))
+    try:
+        start = _time.monotonic()
+        assert channel.request(shm, "ping", timeout=5) == os.getpid()
+        assert _time.monotonic() - start < 5
+    finally:
+        idle.close()
