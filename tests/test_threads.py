@@ -311,3 +311,19 @@ def test_no_deadlock_between_gil_mutex_and_python_functions(tmp_path):
                           cwd=tmp_path)     # not the source tree
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.strip() == "done"
+
+
+def test_thread_made_while_running_starts_at_once(hal):
+    hal.newthread("first", 1_000_000)
+    hal.start()
+    try:
+        hal.newthread("late", 500_000)
+        hal.add_python_function("late.fn", lambda p: None, "late")
+        assert hal.thread("late").running
+        deadline = time.monotonic() + 5
+        while hal.thread("late").cycles < 20 and time.monotonic() < deadline:
+            time.sleep(0.01)
+        assert hal.thread("late").cycles >= 20
+    finally:
+        hal.stop()
+    assert not hal.thread("late").running

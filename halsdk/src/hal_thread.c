@@ -57,6 +57,8 @@ typedef struct {
 } executor_t;
 
 static executor_t execs[HAL_MAX_THREADS];
+static int started_rt;          /* scheduling asked for by the last start */
+static void assign_priorities(void);
 static double ns_per_tick = 1.0;
 static int ticks_calibrated;
 static atomic_int stepping;
@@ -165,6 +167,16 @@ int exec_create(hal_thread_t *t)
         x->time_cell = (volatile int32_t **)SHMPTR(tp->ptr_cell);
         x->tmax = SHMPTR(tm->data);
         x->sim_next = -1;
+        /* threads made while HAL runs start at once */
+        if (hal_map.hdr->threads_running) {
+            assign_priorities();
+            int r = exec_start(s, started_rt, NULL, 0);
+            if (r) {
+                free(atomic_exchange(&x->list, NULL));
+                x->used = 0;
+                return r;
+            }
+        }
         return s;
     }
     return hal_fail(ENOSPC, "thread '%s': no free executor", t->o.name);
@@ -354,12 +366,9 @@ int hal_stop_threads(void)
     return 0;
 }
 
-/* start every thread, faster threads at higher priority */
-int exec_start_all(int want_rt, char *note, int notelen)
+/* faster threads get higher priority, as in the reference */
+static void assign_priorities(void)
 {
-    int r = start_allowed();
-    if (r)
-        return r;
     for (int s = 0; s < HAL_MAX_THREADS; s++) {
         executor_t *x = &execs[s];
         if (!x->used)
@@ -369,6 +378,16 @@ int exec_start_all(int want_rt, char *note, int notelen)
             faster += execs[o].used && execs[o].period < x->period;
         x->t->priority = 90 - faster > 1 ? 90 - faster : 1;
     }
+}
+
+/* start every thread */
+int exec_start_all(int want_rt, char *note, int notelen)
+{
+    int r = start_allowed();
+    if (r)
+        return r;
+    assign_priorities();
+    started_rt = want_rt;
     /* best effort: without the privilege the threads run all the same */
     if (want_rt && getenv("HALSDK_NO_MLOCK") == NULL)
         mlockall(MCL_CURRENT | MCL_FUTURE);
