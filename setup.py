@@ -36,7 +36,8 @@ components = [
 ]
 
 setup(
-    packages=["halsdk", "halsdk.compat", "halsdk.demo", "halsdk.components"],
+    packages=["halsdk", "halsdk.compat", "halsdk.demo", "halsdk.halcmd",
+              "halsdk.components"],
     package_dir={"halsdk.components": "components"},
     ext_modules=cythonize([core] + components, language_level=3, quiet=True,
                           include_path=["."]),

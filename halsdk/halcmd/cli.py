@@ -1,0 +1,287 @@
+"""The ``halcmd`` and ``halrun`` programs.
+
+``halrun`` creates the HAL instance (this process becomes its host),
+runs a file or an interactive prompt, then removes the instance (``-I``:
+prompt first).  ``halcmd`` attaches to a running instance and runs a
+file, one command from its arguments, or a prompt.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from typing import Optional
+
+from halsdk.halcmd.commands import Executor, Quit
+
+_HALCMD_USAGE = """\
+Usage:  halcmd [options] [cmd [args]]
+options:
+  -f [filename]  read commands from 'filename' (default stdin)
+  -i inifile     use inifile for [SECTION]KEY substitution
+  -k             keep going after a failed command
+  -q             print errors only (default)
+  -Q             print nothing
+  -s             script-friendly output of show
+  -v             verbose
+  -V             very verbose
+  -e             echo the commands read from a file
+  -h             this help
+"""
+
+_HALRUN_USAGE = """\
+Usage:  halrun [-I] [-U] [halcmd options] [-f] [filename.hal]
+  -I   run an interactive halcmd after the file, before removing HAL
+  -U   remove HAL instances left behind by dead processes and exit
+  (other options are those of halcmd)
+"""
+
+
+class _Options:
+    def __init__(self) -> None:
+        self.file: Optional[str] = None
+        self.ini: Optional[str] = None
+        self.keep_going = False
+        self.verbose = 0
+        self.script = False
+        self.echo = False
+        self.interactive_after = False
+        self.cleanup = False
+        self.words: list[str] = []
+
+
+def _parse(argv: list[str], prog: str) -> _Options:
+    """Parse getopt-style options; raises SystemExit on bad usage."""
+    opts = _Options()
+    usage = _HALRUN_USAGE if prog == "halrun" else _HALCMD_USAGE
+    i = 0
+    while i < len(argv):
+        arg = argv[i]
+        if arg == "--":
+            i += 1
+            break
+        if not arg.startswith("-") or arg == "-":
+            break
+        letters = arg[1:]
+        j = 0
+        while j < len(letters):
+            c = letters[j]
+            rest = letters[j + 1:]
+            if c in "fi":
+                value: Optional[str] = rest or None
+                if value is None and i + 1 < len(argv) and (
+                        c == "i" or not argv[i + 1].startswith("-")):
+                    i += 1
+                    value = argv[i]
+                if c == "i":
+                    if value is None:
+                        _die(prog, "option -i needs an INI file", usage)
+                    opts.ini = value
+                else:
+                    opts.file = value if value is not None else "-"
+                break
+            if c == "k":
+                opts.keep_going = True
+            elif c == "q":
+                opts.verbose = 0
+            elif c == "Q":
+                opts.verbose = -1
+            elif c in "vV":
+                opts.verbose = 1
+            elif c == "s":
+                opts.script = True
+            elif c == "e":
+                opts.echo = True
+            elif c == "R":
+                pass        # the core's mutex is robust: nothing to release
+            elif c == "I" and prog == "halrun":
+                opts.interactive_after = True
+            elif c == "U" and prog == "halrun":
+                opts.cleanup = True
+            elif c == "T":
+                print(f"{prog}: the Tcl interface (-T) is not supported by "
+                      "halsdk", file=sys.stderr)
+                raise SystemExit(2)
+            elif c == "h":
+                sys.stdout.write(usage)
+                raise SystemExit(0)
+            else:
+                _die(prog, f"unknown option -{c}", usage)
+            j += 1
+        i += 1
+    opts.words = argv[i:]
+    return opts
+
+
+def _die(prog: str, message: str, usage: str) -> None:
+    sys.stderr.write(f"{prog}: {message}\n{usage}")
+    raise SystemExit(1)
+
+
+def _completions(text: str, first_word: bool) -> list[str]:
+    """Command names for the first word, HAL names after it."""
+    from halsdk import _core
+    from halsdk.halcmd.commands import ARG_COUNTS
+    if first_word:
+        names = list(ARG_COUNTS)
+    else:
+        names = [it.name for kind in ("pin", "param", "signal", "function",
+                                      "thread", "component")
+                 for it in _core.items(kind)]
+    return sorted(n for n in names if n.startswith(text))
+
+
+def _setup_readline() -> None:
+    try:
+        import readline
+    except ImportError:
+        return
+    state: dict[str, list[str]] = {}
+
+    def complete(text: str, n: int):
+        if n == 0:
+            before = readline.get_line_buffer()[:readline.get_begidx()]
+            state["m"] = _completions(text, not before.strip())
+        found = state.get("m", [])
+        return found[n] if n < len(found) else None
+
+    readline.set_completer_delims(" \t")
+    readline.set_completer(complete)
+    readline.parse_and_bind("tab: complete")
+
+
+def _interactive(ex: Executor) -> None:
+    """A simple prompt with readline history when it is available."""
+    tty = sys.stdin.isatty()
+    if tty:
+        _setup_readline()
+    ex.filename = "<stdin>"
+    ex.lineno = 0
+    while True:
+        try:
+            line = input("halcmd: " if tty else "")
+        except EOFError:
+            if tty:
+                sys.stdout.write("\n")
+            return
+        except KeyboardInterrupt:
+            sys.stdout.write("\n")
+            continue
+        ex.lineno += 1
+        ex.run_line(line)
+
+
+def _run(ex: Executor, opts: _Options, prog: str) -> int:
+    """Run the file, the command words or the prompt; exit status."""
+    try:
+        if opts.file is not None:
+            if opts.file == "-":
+                ex.run_lines(sys.stdin, "<stdin>")
+            else:
+                ex.run_file(opts.file)
+        elif opts.words:
+            ex.run_words(opts.words)
+        elif prog == "halcmd" or not opts.interactive_after:
+            _interactive(ex)
+        if opts.interactive_after and prog == "halrun":
+            _interactive(ex)
+    except Quit:
+        pass
+    return 1 if ex.errors else 0
+
+
+def _teardown(hal, ex: Executor, opts: _Options) -> None:
+    """What the end of halrun does: stop threads, end loadusr programs."""
+    from halsdk import _core
+    from halsdk.errors import HalError
+    if _core.get_lock() & 8:
+        # the reference's teardown cannot stop threads under a run lock
+        # and says so; the instance is removed anyway
+        if opts.verbose >= 0:
+            sys.stderr.write("HAL: ERROR: stop_threads called while HAL "
+                             "is locked\n")
+        _core.set_lock(0)
+    try:
+        hal.stop()
+    except HalError:
+        pass
+    _end_children(ex)
+
+
+def _end_children(ex: Executor) -> None:
+    """Programs started by loadusr and still running get SIGTERM."""
+    for child in ex.children:
+        if child.poll() is None:
+            child.terminate()
+            try:
+                child.wait(timeout=5)
+            except subprocess.TimeoutExpired:
+                child.kill()
+                child.wait()
+
+
+def halcmd_main(argv: Optional[list[str]] = None) -> int:
+    """Entry point of ``halcmd``: attach to the running instance."""
+    from halsdk import Hal
+    from halsdk.errors import HalError
+    argv = sys.argv[1:] if argv is None else argv
+    opts = _parse(argv, "halcmd")
+    try:
+        hal = Hal(create=False)
+    except HalError as exc:
+        print(f"halcmd: no HAL instance to attach to ({exc}); "
+              "start one with halrun", file=sys.stderr)
+        return 1
+    with hal:
+        ex = Executor(hal, keep_going=opts.keep_going, script=opts.script,
+                      verbose=opts.verbose, ini=opts.ini, echo=opts.echo)
+        try:
+            return _run(ex, opts, "halcmd")
+        finally:
+            ex.unregister()
+
+
+def halrun_main(argv: Optional[list[str]] = None) -> int:
+    """Entry point of ``halrun``: create the instance, run, remove it."""
+    import halsdk
+    from halsdk import Hal
+    from halsdk.errors import HalError
+    argv = sys.argv[1:] if argv is None else argv
+    opts = _parse(argv, "halrun")
+    if opts.cleanup:
+        halsdk.cleanup()
+        return 0
+    if opts.file is None and opts.words:
+        # halrun FILE: the file name may come without -f
+        opts.file, opts.words = opts.words[0], opts.words[1:]
+    if opts.file is None:
+        opts.interactive_after = True
+    try:
+        hal = Hal(create=True)
+    except HalError as exc:
+        print(f"halrun: cannot create the HAL instance: {exc}\n"
+              "halrun: is another halrun running? ('halrun -U' removes "
+              "instances of dead processes)", file=sys.stderr)
+        return 1
+    with hal:
+        ex = Executor(hal, keep_going=opts.keep_going, script=opts.script,
+                      verbose=opts.verbose, ini=opts.ini, echo=opts.echo)
+        try:
+            return _run(ex, opts, "halrun")
+        finally:
+            _teardown(hal, ex, opts)
+
+
+def main(argv: Optional[list[str]] = None) -> int:
+    """``python -m halsdk.halcmd.cli halcmd|halrun [options]``."""
+    argv = sys.argv[1:] if argv is None else argv
+    if not argv or argv[0] not in ("halcmd", "halrun"):
+        sys.stderr.write("usage: python -m halsdk.halcmd.cli "
+                         "halcmd|halrun [options]\n")
+        return 2
+    prog, rest = argv[0], argv[1:]
+    return (halcmd_main if prog == "halcmd" else halrun_main)(rest)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

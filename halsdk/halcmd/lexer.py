@@ -1,0 +1,146 @@
+"""Reading HAL files: logical lines, comments, words and substitutions.
+
+The rules follow the reference halcmd:
+
+* a backslash at the very end of a line joins the next line to it (the
+  line number reported for errors is the one of the last physical line);
+* ``#`` starts a comment, except inside double quotes;
+* words are separated by blanks; a double-quoted string is one word and
+  keeps its quotes (the reference does the same);
+* ``$NAME`` and ``$(NAME)`` are replaced by environment variables,
+  ``[SECTION]KEY`` and ``[SECTION](KEY)`` by entries of the INI file given
+  with ``-i``.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from collections.abc import Iterable, Iterator
+from typing import Optional
+
+
+class SubstitutionError(Exception):
+    """A ``$VAR`` or ``[SECTION]KEY`` that cannot be replaced."""
+
+
+def logical_lines(lines: Iterable[str]) -> Iterator[tuple[int, str]]:
+    """Yield ``(line_number, text)`` with backslash continuations joined."""
+    pending = ""
+    number = 0
+    for number, raw in enumerate(lines, 1):
+        text = raw.rstrip("\r\n")
+        if text.endswith("\\"):
+            pending += text[:-1]
+            continue
+        yield number, pending + text
+        pending = ""
+    if pending:
+        yield number, pending
+
+
+def strip_comment(line: str) -> str:
+    """Remove a ``#`` comment that is not inside double quotes."""
+    quoted = False
+    for i, ch in enumerate(line):
+        if ch == '"':
+            quoted = not quoted
+        elif ch == "#" and not quoted:
+            return line[:i]
+    return line
+
+
+class IniFile:
+    """The entries of an INI file, looked up as ``[SECTION]KEY``.
+
+    Like the reference, the first occurrence of a key wins and keys are
+    case sensitive.
+    """
+
+    def __init__(self, path: str):
+        self.path = path
+        self.values: dict[tuple[str, str], str] = {}
+        section = ""
+        with open(path, encoding="utf-8", errors="replace") as f:
+            for raw in f:
+                line = raw.strip()
+                if not line or line[0] in "#;":
+                    continue
+                if line.startswith("[") and "]" in line:
+                    section = line[1:line.index("]")]
+                    continue
+                if "=" in line:
+                    key, _, value = line.partition("=")
+                    self.values.setdefault((section, key.strip()),
+                                           value.strip())
+
+    def get(self, section: str, key: str) -> Optional[str]:
+        return self.values.get((section, key))
+
+
+_ENV_PAREN = re.compile(r"\$\(([^)]*)\)")
+_ENV_WORD = re.compile(r"\$([A-Za-z0-9_]+)")
+_INI = re.compile(r"\[([^\]]+)\](\(([^)]*)\)|([A-Za-z0-9_]+))")
+
+
+
+def substitute(word: str, ini: Optional[IniFile]) -> str:
+    """Replace environment and INI references in one word."""
+    out = []
+    i = 0
+    while i < len(word):
+        ch = word[i]
+        if ch == "$":
+            m = _ENV_PAREN.match(word, i) or _ENV_WORD.match(word, i)
+            if m is None:
+                if word.startswith("$(", i):
+                    raise SubstitutionError("Missing close parenthesis.")
+                raise SubstitutionError("Empty variable name.")
+            name = m.group(1)
+            value = os.environ.get(name)
+            if value is None:
+                raise SubstitutionError(
+                    f"Environment variable '{name}' not found.")
+            out.append(value)
+            i = m.end()
+            continue
+        if ch == "[":
+            m = _INI.match(word, i)
+            if m is not None:
+                section = m.group(1)
+                key = m.group(3) if m.group(3) is not None else m.group(4)
+                value = ini.get(section, key) if ini is not None else None
+                if value is None:
+                    raise SubstitutionError(
+                        f"Ini variable '[{section}]{key}' not found.")
+                out.append(value)
+                i = m.end()
+                continue
+        out.append(ch)
+        i += 1
+    return "".join(out)
+
+
+def split_words(line: str) -> list[str]:
+    """Split a comment-free line into words (quoted strings kept whole)."""
+    words: list[str] = []
+    cur: list[str] = []
+    quoted = False
+    for ch in line:
+        if ch == '"':
+            quoted = not quoted
+            cur.append(ch)
+        elif ch.isspace() and not quoted:
+            if cur:
+                words.append("".join(cur))
+                cur = []
+        else:
+            cur.append(ch)
+    if cur:
+        words.append("".join(cur))
+    return words
+
+
+def tokenize(line: str, ini: Optional[IniFile] = None) -> list[str]:
+    """The words of one logical line after comments and substitutions."""
+    return [substitute(w, ini) for w in split_words(strip_comment(line))]
