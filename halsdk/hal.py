@@ -25,7 +25,7 @@ Value = Union[bool, int, float, str]
 # requests an attached process forwards to the host
 _HOST_OPS = ("loadrt", "unloadrt", "unload", "newinst", "delinst",
              "newthread", "delthread", "addf", "delf", "start", "stop",
-             "step")
+             "step", "loadrt_args")
 
 
 class Hal:
@@ -109,6 +109,15 @@ class Hal:
     def _host_loadrt(self, name: str, *args: str, **kw: Any) -> list[str]:
         with self._conn.lock:
             return self._conn.registry.load(name, *args, **kw)
+
+    def loadrt_args(self) -> dict[str, str]:
+        """Component name -> the load-line parameters it was loaded with
+        (what ``save comp`` writes)."""
+        return self._call_host("loadrt_args")
+
+    def _host_loadrt_args(self) -> dict[str, str]:
+        with self._conn.lock:
+            return self._conn.registry.load_args()
 
     def unloadrt(self, name: str) -> None:
         """Unload a realtime module (``"all"``: every module)."""

@@ -193,6 +193,7 @@ class Loaded:
     name: str
     module: ModuleType
     comp_ids: list[int] = field(default_factory=list)
+    args: str = ""          # the load line's parameters, as saved
 
 
 class Registry:
@@ -242,7 +243,10 @@ class Registry:
             if isinstance(error, HalError):
                 raise type(error)(f"{name}: {error}") from error
             raise LoadError(f"{name}: setup failed: {error}") from error
-        self.modules[name] = Loaded(name, module, new)
+        words = [w for a in args for w in str(a).split()]
+        words += [f"{k}={v}" for k, v in kwargs.items()]
+        self.modules[name] = Loaded(name, module, new,
+                                    "".join(w + " " for w in words))
         return [_core.comp_by_id(i).name for i in new]
 
     def _undo(self, module: ModuleType, comp_ids: list[int]) -> None:
@@ -265,6 +269,16 @@ class Registry:
     def unload_all(self) -> None:
         for name in reversed(list(self.modules)):
             self.unload(name)
+
+    def load_args(self) -> dict[str, str]:
+        """Component name -> the parameters of the load that made it."""
+        out = {}
+        for loaded in self.modules.values():
+            for cid in loaded.comp_ids:
+                comp = _core.comp_by_id(cid)
+                if comp is not None:
+                    out[comp.name] = loaded.args
+        return out
 
     def module_of_comp(self, comp_name: str) -> Optional[Loaded]:
         comp = _core.find("component", comp_name)

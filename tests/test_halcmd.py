@@ -420,3 +420,16 @@ def test_help_lists_every_command(hal):
     assert cap.out[0].startswith("net SIGNAL PIN")
     assert not ex.run_line("help nosuch")
     assert cap.err[-1] == "No help for unknown command 'nosuch'\n"
+
+
+def test_save_comp_has_load_args_of_another_process(hal, tmp_path):
+    """The host keeps every load's parameters, so a halcmd that did not do
+    the load still saves them."""
+    hal.loadrt("and2", "count=2")
+    assert hal.loadrt_args() == {"and2": "count=2 "}
+    env = dict(os.environ)
+    proc = subprocess.run([sys.executable, "-m", "halsdk.halcmd.cli",
+                           "halcmd", "save", "comp"], env=env, cwd=tmp_path,
+                          capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 0, proc.stderr
+    assert "loadrt and2 count=2" in proc.stdout

@@ -157,7 +157,6 @@ class Executor:
         self.errors = 0
         self.comp_id: Optional[int] = None
         self.children: list[subprocess.Popen] = []
-        self.loadrt_args: dict[str, str] = {}
         if register:
             self.register()
 
@@ -304,12 +303,10 @@ class Executor:
         if self.comp_id is not None:
             self.register()
         try:
-            made = self.hal.loadrt(args[0], *args[1:])
+            self.hal.loadrt(args[0], *args[1:])
         except HalError as exc:
             raise CommandError(f"insmod for {args[0]} failed, returned -1",
                                lines=[f"{args[0]}: {exc}"]) from None
-        for comp in made or ():
-            self.loadrt_args[comp] = "".join(a + " " for a in args[1:])
         self.info(f"Component '{args[0]}' ready")
         self.info(f"Realtime module '{args[0]}' loaded")
 
@@ -738,11 +735,11 @@ class Executor:
     def cmd_save(self, args: list[str]) -> None:
         what = args[0] if args else "all"
         if len(args) < 2:
-            if not Saver(self.out, self.loadrt_args).save(what):
+            if not Saver(self.out, self.hal.loadrt_args()).save(what):
                 raise CommandError(f"Unknown 'save' type '{what}'")
             return
         lines: list[str] = []
-        if not Saver(lines.append, self.loadrt_args).save(what):
+        if not Saver(lines.append, self.hal.loadrt_args()).save(what):
             raise CommandError(f"Unknown 'save' type '{what}'")
         try:
             with open(args[1], "w", encoding="utf-8") as f:
