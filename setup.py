@@ -19,6 +19,7 @@ core = Extension(
         "halsdk/src/hal_core.c",
         "halsdk/src/hal_thread.c",
         "halsdk/src/hal_api.c",
+        "halsdk/src/hal_stream.c",
     ],
     include_dirs=["halsdk/include", "halsdk/src"],
     extra_compile_args=["-O2", "-std=gnu11", "-Wall", "-Wno-unused-function"],
@@ -37,7 +38,7 @@ components = [
 
 setup(
     packages=["halsdk", "halsdk.compat", "halsdk.demo", "halsdk.halcmd",
-              "halsdk.components"],
+              "halsdk.components", "halsdk.tools"],
     package_dir={"halsdk.components": "components"},
     ext_modules=cythonize([core] + components, language_level=3, quiet=True,
                           include_path=["."]),

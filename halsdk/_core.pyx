@@ -31,7 +31,7 @@ cdef extern from "hal_core.h" nogil:
 
     enum:
         K_NONE, K_COMP, K_INST, K_PIN, K_PARAM, K_SIG, K_FUNCT, K_THREAD,
-        K_NKINDS
+        K_STREAM, K_NKINDS, HAL_STREAM_MAX_ELEMS
         HALSDK_BIT, HALSDK_FLOAT, HALSDK_S32, HALSDK_U32, HALSDK_S64,
         HALSDK_U64, HALSDK_IN, HALSDK_OUT, HALSDK_IO, HALSDK_RO, HALSDK_RW
         HALSDK_COMP_USER, HALSDK_COMP_RT, HALSDK_NAME_LEN
@@ -100,6 +100,22 @@ cdef extern from "hal_core.h" nogil:
         int32_t nfuncts
         uint64_t cycles, overruns
 
+    ctypedef union halsdk_value_t:
+        uint8_t b
+        int32_t s
+        uint32_t u
+        double f
+        int64_t ls
+        uint64_t lu
+
+    ctypedef struct hal_stream_t:
+        hal_obj_t o
+        hoff_t comp, inst
+        int32_t nelem, depth
+        uint32_t stride
+        uint8_t types[256]
+        uint64_t num_overruns, num_underruns, sampleno
+
     ctypedef struct hal_header_t:
         uint32_t abi
         uint64_t size
@@ -111,8 +127,8 @@ cdef extern from "hal_core.h" nogil:
         int32_t msg_level
         hoff_t heap_start, heap_top, heap_end
         uint64_t bytes_used
-        hoff_t list_head[8]
-        int32_t count[8]
+        hoff_t list_head[9]
+        int32_t count[9]
         int32_t sim_clock
         int64_t sim_time
         int32_t threads_running
@@ -178,6 +194,16 @@ cdef extern from "hal_core.h" nogil:
     int hal_check_consistency(char *rep, int len)
     hal_value_t *hal_pin_value(hal_pin_t *pin)
     void *hal_param_value(hal_param_t *param)
+    long long hal_stream_create(const char *name, int owner_id, int depth,
+                                const char *typestring)
+    long long hal_stream_attach(const char *name)
+    hal_stream_t *hal_stream_get(long long handle)
+    int hal_stream_write(long long handle, const halsdk_value_t *rec)
+    int hal_stream_read(long long handle, halsdk_value_t *rec,
+                        uint64_t *sampleno)
+    int hal_stream_depth(long long handle)
+    int hal_stream_parse_types(const char *typestring, uint8_t *types,
+                               const char *what)
     long long hal_get_time()
     void *(*hal_gil_release)() noexcept nogil
     void (*hal_gil_restore)(void *) noexcept nogil
@@ -416,7 +442,7 @@ cdef class Item:
 
 KIND_WORDS = {K_COMP: "component", K_INST: "instance", K_PIN: "pin",
               K_PARAM: "param", K_SIG: "signal", K_FUNCT: "function",
-              K_THREAD: "thread"}
+              K_THREAD: "thread", K_STREAM: "stream"}
 
 
 cdef Item make(int kind, void *p):
@@ -760,9 +786,157 @@ cdef class Thread(Item):
         return out
 
 
+_STREAM_LETTER = {HALSDK_FLOAT: "f", HALSDK_BIT: "b", HALSDK_S32: "s",
+                  HALSDK_U32: "u", HALSDK_S64: "l", HALSDK_U64: "k"}
+_STREAM_DTYPE = {HALSDK_FLOAT: "<f8", HALSDK_BIT: "?", HALSDK_S32: "<i4",
+                 HALSDK_U32: "<u4", HALSDK_S64: "<i8", HALSDK_U64: "<u8"}
+
+
+cdef class Stream(Item):
+    """A stream: a realtime-safe FIFO of records in the instance.
+
+    One process writes (normally a realtime function), one reads.  Each
+    record holds one value per letter of the type string (f float, b bit,
+    s s32, u u32, l s64, k u64) and the number of the sample (records
+    written before it).  ``write``/``read`` never block.
+    """
+
+    cdef long long handle(self) except -1:
+        self.rec()
+        return (<long long>self.gen << 32) | <long long>self.off
+
+    @property
+    def owner(self) -> str:
+        """Name of the owning component."""
+        return comp_name((<hal_stream_t *>self.rec()).comp)
+
+    @property
+    def nelem(self) -> int:
+        """Values per record."""
+        return (<hal_stream_t *>self.rec()).nelem
+
+    @property
+    def typestring(self) -> str:
+        """One letter per value: f b s u l k."""
+        cdef hal_stream_t *st = <hal_stream_t *>self.rec()
+        return "".join(_STREAM_LETTER[st.types[i]] for i in range(st.nelem))
+
+    @property
+    def types(self) -> list:
+        """Type numbers of the values (BIT, FLOAT, ...)."""
+        cdef hal_stream_t *st = <hal_stream_t *>self.rec()
+        return [st.types[i] for i in range(st.nelem)]
+
+    @property
+    def maxdepth(self) -> int:
+        """Capacity in records."""
+        return (<hal_stream_t *>self.rec()).depth
+
+    @property
+    def depth(self) -> int:
+        """Records written and not read yet."""
+        return check(hal_stream_depth(self.handle()))
+
+    @property
+    def overruns(self) -> int:
+        """Writes that found the FIFO full (the record was dropped)."""
+        return (<hal_stream_t *>self.rec()).num_overruns
+
+    @property
+    def underruns(self) -> int:
+        """Reads that found the FIFO empty."""
+        return (<hal_stream_t *>self.rec()).num_underruns
+
+    @property
+    def sampleno(self) -> int:
+        """Records written so far (the number of the next one)."""
+        return (<hal_stream_t *>self.rec()).sampleno
+
+    def write(self, values) -> bool:
+        """Append one record; False (and one more overrun) when full."""
+        cdef hal_stream_t *st = <hal_stream_t *>self.rec()
+        cdef int n = st.nelem
+        cdef halsdk_value_t rec[256]
+        vals = list(values)
+        if len(vals) != n:
+            raise _errors.InvalidError(
+                f"stream '{self._name}' takes {n} values per record, "
+                f"not {len(vals)}")
+        memset(rec, 0, sizeof(rec))
+        for i in range(n):
+            t = st.types[i]
+            v = parse_value(t, vals[i], f"value {i} of stream '{self._name}'")
+            put_raw(t, &rec[i], v)
+        cdef int r = hal_stream_write(self.handle(), rec)
+        if r == -28:        # ENOSPC
+            return False
+        check(r)
+        return True
+
+    def read(self):
+        """(sample number, tuple of values) of the oldest record, or None
+        (and one more underrun) when the FIFO is empty."""
+        cdef hal_stream_t *st = <hal_stream_t *>self.rec()
+        cdef halsdk_value_t rec[256]
+        cdef uint64_t sn = 0
+        cdef int r = hal_stream_read(self.handle(), rec, &sn)
+        if r == -11:        # EAGAIN
+            return None
+        check(r)
+        return sn, tuple(get_raw(st.types[i], &rec[i])
+                         for i in range(st.nelem))
+
+    def dtype(self, names=None):
+        """NumPy dtype of a record: field ``sample`` then one per value
+        (named by ``names``, default ``v0``, ``v1``, ...)."""
+        import numpy as np
+        cdef hal_stream_t *st = <hal_stream_t *>self.rec()
+        n = st.nelem
+        if names is None:
+            names = [f"v{i}" for i in range(n)]
+        names = list(names)
+        if len(names) != n:
+            raise _errors.InvalidError(
+                f"stream '{self._name}' has {n} values, got {len(names)} "
+                "names")
+        return np.dtype({
+            "names": ["sample"] + names,
+            "formats": ["<u8"] + [_STREAM_DTYPE[st.types[i]]
+                                  for i in range(n)],
+            "offsets": [8 * i for i in range(n + 1)],
+            "itemsize": 8 * (n + 1)})
+
+    def read_many(self, long max=-1, names=None):
+        """Read up to ``max`` records (all available when negative) into a
+        NumPy structured array (see :meth:`dtype`), without counting an
+        underrun.  ``arr["v0"]`` is the first column."""
+        import numpy as np
+        dt = self.dtype(names)
+        cdef long long h = self.handle()
+        cdef long avail = check(hal_stream_depth(h))
+        cdef long n = avail if max < 0 or max > avail else max
+        cdef long stride = dt.itemsize
+        raw = np.empty(n * stride, dtype=np.uint8)
+        cdef unsigned char[::1] mv = raw
+        cdef long k = 0
+        cdef int r = 0
+        if n > 0:
+            with nogil:
+                while k < n:
+                    r = hal_stream_read(
+                        h, <halsdk_value_t *>&mv[k * stride + 8],
+                        <uint64_t *>&mv[k * stride])
+                    if r < 0:
+                        break
+                    k += 1
+        if r < 0 and r != -11:
+            check(r)
+        return raw[:k * stride].view(dt)
+
+
 _KIND_CLASS = {K_COMP: Component, K_INST: Instance, K_PIN: Pin,
                K_PARAM: Param, K_SIG: Signal, K_FUNCT: Function,
-               K_THREAD: Thread}
+               K_THREAD: Thread, K_STREAM: Stream}
 
 
 # ---------------------------------------------------------------- instance
@@ -1248,3 +1422,106 @@ def step(long n=1, thread=None):
         with nogil:
             r = exec_run_cycles(slot, cycles)
     check(r)
+
+
+# ---------------------------------------------------------------- streams
+
+def stream_parse_types(typestring, str what="stream") -> list:
+    """Type numbers of a stream type string; InvalidError names ``what``."""
+    cdef uint8_t types[256]
+    cdef bytes b = enc(typestring)
+    cdef bytes w = enc(what)
+    cdef int n = check(hal_stream_parse_types(b, types, w))
+    return [types[i] for i in range(n)]
+
+
+def stream_create(name, int owner_id, int depth, typestring) -> Stream:
+    """Create a stream owned by a component or instance of this process;
+    it is deleted with its owner."""
+    need_instance()
+    cdef bytes b = enc(name), t = enc(typestring)
+    cdef long long h = hal_stream_create(b, owner_id, depth, t)
+    if h < 0:
+        check(<int>h)
+    return stream_attach(name)
+
+
+def stream_attach(name) -> Stream:
+    """The handle of an existing stream (NotFoundError if there is none)."""
+    need_instance()
+    cdef bytes b = enc(name)
+    cdef long long h = hal_stream_attach(b)
+    if h < 0:
+        check(<int>h)
+    s = find("stream", name)
+    if s is None:
+        raise _errors.NotFoundError(f"stream '{name}' not found")
+    return s
+
+
+# capture: a realtime function that copies pins, signals or params into a
+# stream once per call
+
+ctypedef struct capture_t:
+    long long handle
+    int n
+    int overruns
+    hoff_t offs[256]
+    uint8_t kinds[256]
+    halsdk_value_t rec[256]
+
+
+cdef void capture_fn(void *arg, long period) noexcept nogil:
+    cdef capture_t *c = <capture_t *>arg
+    cdef int i
+    cdef hal_value_t *v
+    for i in range(c.n):
+        if c.kinds[i] == K_PIN:
+            v = hal_pin_value(<hal_pin_t *>SHMPTR(c.offs[i]))
+        elif c.kinds[i] == K_SIG:
+            v = &(<hal_sig_t *>SHMPTR(c.offs[i])).value
+        else:
+            v = <hal_value_t *>hal_param_value(
+                <hal_param_t *>SHMPTR(c.offs[i]))
+        c.rec[i].lu = v.lu
+    if hal_stream_write(c.handle, c.rec) < 0:
+        c.overruns += 1
+
+
+def capture_new(int comp_id, funct_name, stream_name, items, long depth,
+                bint uses_fp=True) -> Stream:
+    """Make the stream and the capture function of a capture: ``items`` are
+    Pin, Signal or Param handles, one value each per call."""
+    need_instance()
+    cdef Item it
+    n = len(items)
+    if not 1 <= n <= HAL_STREAM_MAX_ELEMS:
+        raise _errors.InvalidError(
+            f"capture of {n} values: 1 to {HAL_STREAM_MAX_ELEMS} allowed")
+    letters = []
+    for obj in items:
+        if not isinstance(obj, (Pin, Param, Signal)):
+            raise _errors.InvalidError(f"cannot capture {obj!r}")
+        letters.append(_STREAM_LETTER[obj.type])
+    if depth < 1 or depth > 0x7fffffff:
+        raise _errors.InvalidError(f"capture of {depth} cycles: 1 to "
+                                   f"{0x7fffffff} allowed")
+    st = stream_create(stream_name, comp_id, depth, "".join(letters))
+    cdef capture_t *c = <capture_t *>hal_malloc_owned(sizeof(capture_t),
+                                                      comp_id)
+    if c == NULL:
+        check(-12)
+    c.handle = (<Stream>st).handle()
+    c.n = n
+    for i, obj in enumerate(items):
+        it = <Item>obj
+        it.rec()
+        c.offs[i] = it.off
+        c.kinds[i] = it.kind
+    cdef bytes b = enc(funct_name)
+    cdef const char *cb = b
+    cdef int r
+    with nogil:
+        r = hal_export_funct(cb, capture_fn, c, uses_fp, 0, comp_id, 0)
+    check(r)
+    return st

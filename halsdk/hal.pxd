@@ -107,6 +107,30 @@ cdef extern from "hal.h" nogil:
     int halsdk_inst_new(const char *name, int comp_id)
     const char *halsdk_last_error()
 
+    # streams (halsdk): realtime-safe FIFOs of records
+    ctypedef union halsdk_value_t:
+        unsigned char b
+        int s
+        unsigned int u
+        double f
+        long long ls
+        unsigned long long lu
+    ctypedef long long halsdk_stream_t
+    enum:
+        HALSDK_STREAM_MAX_ELEMS
+    halsdk_stream_t halsdk_stream_create(const char *name, int owner_id,
+                                         int depth, const char *typestring)
+    halsdk_stream_t halsdk_stream_attach(const char *name)
+    int halsdk_stream_write(halsdk_stream_t s, const halsdk_value_t *rec)
+    int halsdk_stream_read(halsdk_stream_t s, halsdk_value_t *rec,
+                           unsigned long long *sampleno)
+    int halsdk_stream_depth(halsdk_stream_t s)
+    int halsdk_stream_maxdepth(halsdk_stream_t s)
+    long long halsdk_stream_num_overruns(halsdk_stream_t s)
+    long long halsdk_stream_num_underruns(halsdk_stream_t s)
+    int halsdk_stream_nelem(halsdk_stream_t s)
+    int halsdk_stream_elem_type(halsdk_stream_t s, int index)
+
 cdef extern from "rtapi.h" nogil:
     ctypedef enum msg_level_t:
         RTAPI_MSG_NONE, RTAPI_MSG_ERR, RTAPI_MSG_WARN, RTAPI_MSG_INFO

@@ -507,6 +507,91 @@ class Hal:
     def instances(self, pattern: Union[str, Iterable[str]] = "*") -> list:
         return self._list("instance", pattern)
 
+    # ------------------------------------------------------------ capture
+
+    def stream(self, name: str) -> _core.Stream:
+        """The stream ``name`` (e.g. ``"sampler.0"``): a realtime FIFO that
+        can be read in bulk into NumPy arrays (``read_many``)."""
+        return _core.stream_attach(name)
+
+    def capture(self, names: Union[str, Iterable[str]], cycles: int,
+                thread: Optional[str] = None, position: int = -1,
+                timeout: Optional[float] = None) -> dict:
+        """Record pins, signals or params once per cycle of a thread.
+
+        A realtime function (added to ``thread`` at ``position``, default:
+        last, after every other function) copies the values into a stream
+        on each cycle; the result maps each name to a NumPy array of
+        ``cycles`` values.  When the threads are not running, the threads
+        are stepped (simulated time) until ``cycles`` cycles of ``thread``
+        ran, so exactly one record per cycle is taken; when they run, this
+        waits (at most ``timeout`` seconds) for ``cycles`` cycles.  The
+        default thread is the fastest one.  Host process only.
+        """
+        if not self._conn.host:
+            raise NotPermittedError("capture runs a realtime function and "
+                                    "works in the host process only")
+        if isinstance(names, str):
+            names = [names]
+        names = list(names)
+        if len(set(names)) != len(names):
+            raise InvalidError(f"capture: names repeat: {names}")
+        if not isinstance(cycles, int) or cycles < 1:
+            raise InvalidError(f"capture: cycles={cycles!r} is not a "
+                               "positive integer")
+        items = []
+        for name in names:
+            obj = (_core.find("pin", name) or _core.find("signal", name)
+                   or _core.find("param", name))
+            if obj is None:
+                raise NotFoundError(f"capture: no pin, signal or param "
+                                    f"named '{name}'")
+            items.append(obj)
+        threads = _core.items("thread")
+        if thread is None:
+            if not threads:
+                raise NotFoundError("capture: there are no threads")
+            th = min(threads, key=lambda t: t.period)
+        else:
+            th = self.thread(thread)
+        Hal._captures += 1
+        comp = f"__capture{os.getpid()}.{Hal._captures}"
+        _core.set_loading_rt(True)
+        try:
+            cid = _core.comp_new(comp, _core.COMP_RT)
+        finally:
+            _core.set_loading_rt(False)
+        try:
+            uses_fp = any(o.type == _core.FLOAT for o in items)
+            stream = _core.capture_new(cid, comp, comp, items, cycles,
+                                       uses_fp)
+            _core.comp_ready(cid, True)
+            _core.addf(comp, th.name, position)
+            if _core.info()["threads_running"]:
+                limit = timeout if timeout is not None else \
+                    5.0 + 2.0 * cycles * th.period * 1e-9
+                deadline = time.monotonic() + limit
+                while stream.depth < cycles:
+                    if time.monotonic() > deadline:
+                        raise TimeoutError(
+                            f"capture: {stream.depth} of {cycles} cycles of "
+                            f"thread '{th.name}' in {limit:.1f} s")
+                    time.sleep(min(0.01, th.period * 1e-9 * 10))
+            else:
+                base = min(t.period for t in threads)
+                if th.period == base:
+                    _core.step(cycles)
+                else:
+                    _core.step(-(-cycles * th.period // base))
+                while stream.depth < cycles:
+                    _core.step(1)
+            arr = stream.read_many(cycles, names)
+            return {n: arr[n].copy() for n in names}
+        finally:
+            _core.comp_exit(cid)
+
+    _captures = 0
+
     def check(self) -> None:
         """Verify the instance's invariants; raise if any is broken."""
         bad, report = _core.check_consistency()

@@ -274,6 +274,55 @@ static inline const char *halsdk_last_error(void)
     return HALSDK_API->last_error();
 }
 
+/* streams (halsdk): realtime-safe single-producer single-consumer FIFOs
+   of records, one value (halsdk_value_t) per letter of the type string
+   (f float, b bit, s s32, u u32, l s64, k u64).  A handle is >= 0. */
+typedef long long halsdk_stream_t;
+static inline halsdk_stream_t halsdk_stream_create(const char *name,
+                                                   int owner_id, int depth,
+                                                   const char *typestring)
+{
+    return HALSDK_API->stream_create(name, owner_id, depth, typestring);
+}
+static inline halsdk_stream_t halsdk_stream_attach(const char *name)
+{
+    return HALSDK_API->stream_attach(name);
+}
+static inline int halsdk_stream_write(halsdk_stream_t s,
+                                      const halsdk_value_t *rec)
+{
+    return HALSDK_API->stream_write(s, rec);
+}
+static inline int halsdk_stream_read(halsdk_stream_t s, halsdk_value_t *rec,
+                                     rtapi_u64 *sampleno)
+{
+    return HALSDK_API->stream_read(s, rec, (uint64_t *)sampleno);
+}
+static inline int halsdk_stream_depth(halsdk_stream_t s)
+{
+    return HALSDK_API->stream_depth(s);
+}
+static inline int halsdk_stream_maxdepth(halsdk_stream_t s)
+{
+    return HALSDK_API->stream_maxdepth(s);
+}
+static inline long long halsdk_stream_num_overruns(halsdk_stream_t s)
+{
+    return HALSDK_API->stream_num_overruns(s);
+}
+static inline long long halsdk_stream_num_underruns(halsdk_stream_t s)
+{
+    return HALSDK_API->stream_num_underruns(s);
+}
+static inline int halsdk_stream_nelem(halsdk_stream_t s)
+{
+    return HALSDK_API->stream_nelem(s);
+}
+static inline int halsdk_stream_elem_type(halsdk_stream_t s, int index)
+{
+    return HALSDK_API->stream_elem_type(s, index);
+}
+
 static inline int hal_set_lock(unsigned char lock_type)
 {
     return HALSDK_API->set_lock(lock_type);

@@ -21,7 +21,7 @@
 extern "C" {
 #endif
 
-#define HALSDK_API_VERSION 1
+#define HALSDK_API_VERSION 2
 #define HALSDK_CAPSULE_NAME "halsdk._core._C_API"
 
 /* longest object name, not counting the terminating NUL */
@@ -47,6 +47,19 @@ extern "C" {
 #define HALSDK_COMP_RT 1
 
 typedef void (*halsdk_funct_t)(void *arg, long period);
+
+/* one value of a stream record (8 bytes, the member of the element type) */
+typedef union {
+    uint8_t b;
+    int32_t s;
+    uint32_t u;
+    double f;
+    int64_t ls;
+    uint64_t lu;
+} halsdk_value_t;
+
+/* most values per stream record */
+#define HALSDK_STREAM_MAX_ELEMS 256
 
 typedef struct halsdk_api {
     int version;
@@ -98,6 +111,22 @@ typedef struct halsdk_api {
     long long (*get_time)(void);
     long long (*get_clocks)(void);
     const char *(*last_error)(void);
+
+    /* --- version 2: streams (realtime-safe FIFOs) --- */
+    /* handles are >= 0; errors are -errno.  write and read never block,
+       lock or allocate: -ENOSPC when full, -EAGAIN when empty */
+    long long (*stream_create)(const char *name, int owner_id, int depth,
+                               const char *typestring);
+    long long (*stream_attach)(const char *name);
+    int (*stream_write)(long long handle, const halsdk_value_t *rec);
+    int (*stream_read)(long long handle, halsdk_value_t *rec,
+                       uint64_t *sampleno);
+    int (*stream_depth)(long long handle);
+    int (*stream_maxdepth)(long long handle);
+    long long (*stream_num_overruns)(long long handle);
+    long long (*stream_num_underruns)(long long handle);
+    int (*stream_nelem)(long long handle);
+    int (*stream_elem_type)(long long handle, int index);
 } halsdk_api;
 
 #ifdef __cplusplus

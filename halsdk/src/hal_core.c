@@ -45,7 +45,7 @@ static const char *kind_word(int kind)
 {
     static const char *const words[K_NKINDS] = {
         "object", "component", "instance", "pin", "param", "signal",
-        "function", "thread"
+        "function", "thread", "stream"
     };
     return kind > 0 && kind < K_NKINDS ? words[kind] : "object";
 }
@@ -397,6 +397,22 @@ static void obj_delete(hal_obj_t *o)
     o->kind = K_NONE;
     o->gen = 0;         /* stale handles see the record is gone */
     hal_free(o);
+}
+
+/* for the other parts of the core (streams) */
+void *hal_obj_new(int kind, long size, const char *name)
+{
+    return obj_new(kind, size, name);
+}
+
+void hal_obj_publish(hal_obj_t *o)
+{
+    obj_publish(o);
+}
+
+void hal_obj_delete(hal_obj_t *o)
+{
+    obj_delete(o);
 }
 
 #define FOR_EACH(kind, type, var)                                         \
@@ -1281,6 +1297,7 @@ static void delete_items_of(hoff_t comp, hoff_t inst)
                 hal_free(SHMPTR(p->oldname));
             obj_delete(&p->o);
         }
+    hal_stream_delete_of(comp, inst);
 }
 
 int hal_inst_delete(const char *name)

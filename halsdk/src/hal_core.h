@@ -20,7 +20,7 @@
 #include <sys/types.h>
 
 #define HAL_MAGIC 0x31304b4453474c48ULL   /* "HLGSDK01" */
-#define HAL_ABI_VERSION 1
+#define HAL_ABI_VERSION 2
 #define HAL_NAME_SIZE (HALSDK_NAME_LEN + 1)
 #define HAL_DEFAULT_SIZE (160L * 1024 * 1024)
 #define HAL_MIN_SIZE (1L * 1024 * 1024)
@@ -39,6 +39,7 @@ typedef union {
 
 enum hal_kind {
     K_NONE = 0, K_COMP, K_INST, K_PIN, K_PARAM, K_SIG, K_FUNCT, K_THREAD,
+    K_STREAM,
     K_NKINDS
 };
 
@@ -138,6 +139,30 @@ typedef struct {
     hoff_t time_pin, tmax_param;
     uint64_t cycles, overruns;
 } hal_thread_t;
+
+/*
+ * A stream: a single-producer single-consumer FIFO of records (hal_stream.c).
+ * The ring follows the record in the same block.  A record is one 64-bit
+ * sample number followed by nelem 8-byte values.  The indices only grow;
+ * slot = index % depth.  Only the writer stores write_idx and sampleno,
+ * only the reader stores read_idx.
+ */
+#define HAL_STREAM_MAX_ELEMS 256
+
+typedef struct {
+    hal_obj_t o;
+    hoff_t comp, inst;          /* owner: deleted with it */
+    int32_t nelem, depth;
+    uint32_t stride;            /* bytes per record */
+    uint32_t pad;
+    uint8_t types[HAL_STREAM_MAX_ELEMS];
+    uint64_t num_overruns;      /* writes that found the FIFO full */
+    uint64_t num_underruns;     /* reads that found it empty */
+    uint64_t sampleno;          /* records written */
+    uint64_t write_idx __attribute__((aligned(64)));
+    uint64_t read_idx __attribute__((aligned(64)));
+    uint64_t pad2 __attribute__((aligned(64)));
+} hal_stream_t;
 
 /* an allocated block; the user data follows the header */
 typedef struct {
@@ -260,6 +285,27 @@ int hal_delf(const char *funct, const char *thread);
 int hal_stop_threads(void);
 int hal_set_lock(unsigned char lock);
 int hal_check_consistency(char *report, int len);
+
+/* streams (hal_stream.c); handles pack (gen << 32) | offset */
+void *hal_obj_new(int kind, long size, const char *name);
+void hal_obj_publish(hal_obj_t *o);
+void hal_obj_delete(hal_obj_t *o);
+void hal_stream_delete_of(hoff_t comp, hoff_t inst);   /* lock held */
+long long hal_stream_create(const char *name, int owner_id, int depth,
+                            const char *typestring);
+long long hal_stream_attach(const char *name);
+hal_stream_t *hal_stream_get(long long handle);
+int hal_stream_write(long long handle, const halsdk_value_t *rec);
+int hal_stream_read(long long handle, halsdk_value_t *rec,
+                    uint64_t *sampleno);
+int hal_stream_depth(long long handle);
+int hal_stream_maxdepth(long long handle);
+long long hal_stream_num_overruns(long long handle);
+long long hal_stream_num_underruns(long long handle);
+int hal_stream_nelem(long long handle);
+int hal_stream_elem_type(long long handle, int index);
+int hal_stream_parse_types(const char *typestring, uint8_t *types,
+                           const char *what);
 
 /* values */
 hal_value_t *hal_pin_value(hal_pin_t *pin);

@@ -1,0 +1,268 @@
+/*
+ * hal_stream.c - streams: named single-producer single-consumer FIFOs of
+ * fixed-layout records in the instance segment (sampler, streamer, the
+ * Python capture API).
+ *
+ * Creating, finding and deleting a stream take the instance mutex.
+ * Writing and reading never do: the writer owns write_idx and sampleno,
+ * the reader owns read_idx, and each publishes its index with a release
+ * store after it has copied the record, so the other side sees a whole
+ * record once it sees the index (acquire load).  Nothing on that path
+ * allocates, locks or makes a system call.
+ *
+ * A handle packs the record's generation and offset, (gen << 32) | off,
+ * so a handle of a deleted stream is recognised as stale instead of
+ * reading whatever was allocated in its place.
+ */
+#define _GNU_SOURCE
+#include "hal_core.h"
+
+#include <errno.h>
+#include <stdio.h>
+#include <string.h>
+#include <unistd.h>
+
+#define RING(s) ((char *)(s) + sizeof(hal_stream_t))
+
+int hal_stream_parse_types(const char *typestring, uint8_t *types,
+                           const char *what)
+{
+    int n = 0;
+    if (!typestring || !*typestring)
+        return hal_fail(EINVAL, "%s: empty type string (one letter per "
+                        "value: f float, b bit, s s32, u u32, l s64, "
+                        "k u64)", what);
+    for (const char *p = typestring; *p; p++) {
+        int t;
+        switch (*p) {
+        case 'f': case 'F': t = HALSDK_FLOAT; break;
+        case 'b': case 'B': t = HALSDK_BIT; break;
+        case 's': case 'S': t = HALSDK_S32; break;
+        case 'u': case 'U': t = HALSDK_U32; break;
+        case 'l': case 'L': t = HALSDK_S64; break;
+        case 'k': case 'K': t = HALSDK_U64; break;
+        default:
+            return hal_fail(EINVAL, "%s: unknown type '%c' in type string "
+                            "'%s' (letters: f float, b bit, s s32, u u32, "
+                            "l s64, k u64)", what, *p, typestring);
+        }
+        if (n >= HAL_STREAM_MAX_ELEMS)
+            return hal_fail(EINVAL, "%s: type string '%.20s...' has more "
+                            "than %d values", what, typestring,
+                            HAL_STREAM_MAX_ELEMS);
+        if (types)
+            types[n] = (uint8_t)t;
+        n++;
+    }
+    return n;
+}
+
+static long long handle_of(hal_stream_t *s)
+{
+    return ((long long)s->o.gen << 32) | (long long)SHMOFF(s);
+}
+
+hal_stream_t *hal_stream_get(long long handle)
+{
+    hal_header_t *h = hal_map.hdr;
+    if (!h || handle < 0)
+        return NULL;
+    hoff_t off = (hoff_t)(handle & 0xffffffffLL);
+    uint32_t gen = (uint32_t)((unsigned long long)handle >> 32);
+    if (off < h->heap_start || off + sizeof(hal_stream_t) > h->heap_end)
+        return NULL;
+    hal_stream_t *s = SHMPTR(off);
+    if (__atomic_load_n(&s->o.kind, __ATOMIC_ACQUIRE) != K_STREAM ||
+        s->o.gen != gen)
+        return NULL;
+    return s;
+}
+
+static int stale(void)
+{
+    return hal_fail(ENOENT, "the stream no longer exists (its component "
+                    "was removed)");
+}
+
+long long hal_stream_create(const char *name, int owner_id, int depth,
+                            const char *typestring)
+{
+    char what[HAL_NAME_SIZE + 16];
+    uint8_t types[HAL_STREAM_MAX_ELEMS];
+    int r = hal_check_name(name, "stream");
+    if (r)
+        return r;
+    snprintf(what, sizeof(what), "stream '%s'", name);
+    int n = hal_stream_parse_types(typestring, types, what);
+    if (n < 0)
+        return n;
+    if (depth < 1)
+        return hal_fail(EINVAL, "%s: depth %d is not a positive number of "
+                        "records", what, depth);
+    uint64_t stride = 8 * (uint64_t)(n + 1);
+    uint64_t size = sizeof(hal_stream_t) + (uint64_t)depth * stride;
+    if (!hal_map.hdr)
+        return hal_fail(ENODEV, "no HAL instance is attached");
+    if (size > (uint64_t)(hal_map.hdr->heap_end - hal_map.hdr->heap_start))
+        return hal_fail(ENOMEM, "%s: %d records of %d values do not fit in "
+                        "the HAL instance", what, depth, n);
+    if ((r = hal_lock()))
+        return r;
+    hoff_t comp = 0, inst = 0;
+    hal_comp_t *c = hal_comp_by_id(owner_id);
+    if (!c) {
+        hal_inst_t *i = hal_inst_by_id(owner_id);
+        if (i) {
+            inst = SHMOFF(i);
+            c = SHMPTR(i->comp);
+        }
+    }
+    long long ret;
+    if (!c) {
+        ret = hal_fail(EINVAL, "%s: no component with id %d", what,
+                       owner_id);
+        goto out;
+    }
+    if (c->pid != getpid()) {
+        ret = hal_fail(EPERM, "%s: component '%s' belongs to process %d",
+                       what, c->o.name, c->pid);
+        goto out;
+    }
+    comp = SHMOFF(c);
+    if (hal_find(K_STREAM, name)) {
+        ret = hal_fail(EEXIST, "duplicate stream name '%s'", name);
+        goto out;
+    }
+    hal_stream_t *s = hal_obj_new(K_STREAM, (long)size, name);
+    if (!s) {
+        ret = -ENOMEM;
+        goto out;
+    }
+    s->comp = comp;
+    s->inst = inst;
+    s->nelem = n;
+    s->depth = depth;
+    s->stride = (uint32_t)stride;
+    memcpy(s->types, types, (size_t)n);
+    hal_obj_publish(&s->o);
+    ret = handle_of(s);
+out:
+    hal_unlock();
+    return ret;
+}
+
+long long hal_stream_attach(const char *name)
+{
+    if (!name || !*name)
+        return hal_fail(EINVAL, "stream name is empty");
+    int r = hal_lock();
+    if (r)
+        return r;
+    hal_stream_t *s = hal_find(K_STREAM, name);
+    long long ret = s ? handle_of(s)
+                      : hal_fail(ENOENT, "stream '%s' not found", name);
+    hal_unlock();
+    return ret;
+}
+
+/* lock held: remove the streams of a component (inst == 0) or of one of
+   its instances */
+void hal_stream_delete_of(hoff_t comp, hoff_t inst)
+{
+    hal_header_t *h = hal_map.hdr;
+    for (hoff_t o = h->list_head[K_STREAM]; o;) {
+        hal_stream_t *s = SHMPTR(o);
+        o = s->o.next;
+        if (s->comp == comp && (!inst || s->inst == inst))
+            hal_obj_delete(&s->o);
+    }
+}
+
+int hal_stream_write(long long handle, const halsdk_value_t *rec)
+{
+    hal_stream_t *s = hal_stream_get(handle);
+    if (!s)
+        return stale();
+    uint64_t w = __atomic_load_n(&s->write_idx, __ATOMIC_RELAXED);
+    uint64_t r = __atomic_load_n(&s->read_idx, __ATOMIC_ACQUIRE);
+    if (w - r >= (uint64_t)s->depth) {
+        __atomic_fetch_add(&s->num_overruns, 1, __ATOMIC_RELAXED);
+        return -ENOSPC;
+    }
+    char *slot = RING(s) + (w % (uint64_t)s->depth) * s->stride;
+    uint64_t sn = __atomic_load_n(&s->sampleno, __ATOMIC_RELAXED);
+    memcpy(slot, &sn, 8);
+    memcpy(slot + 8, rec, (size_t)s->nelem * 8);
+    __atomic_store_n(&s->sampleno, sn + 1, __ATOMIC_RELAXED);
+    __atomic_store_n(&s->write_idx, w + 1, __ATOMIC_RELEASE);
+    return 0;
+}
+
+int hal_stream_read(long long handle, halsdk_value_t *rec,
+                    uint64_t *sampleno)
+{
+    hal_stream_t *s = hal_stream_get(handle);
+    if (!s)
+        return stale();
+    uint64_t r = __atomic_load_n(&s->read_idx, __ATOMIC_RELAXED);
+    uint64_t w = __atomic_load_n(&s->write_idx, __ATOMIC_ACQUIRE);
+    if (r == w) {
+        __atomic_fetch_add(&s->num_underruns, 1, __ATOMIC_RELAXED);
+        return -EAGAIN;
+    }
+    const char *slot = RING(s) + (r % (uint64_t)s->depth) * s->stride;
+    if (sampleno)
+        memcpy(sampleno, slot, 8);
+    memcpy(rec, slot + 8, (size_t)s->nelem * 8);
+    __atomic_store_n(&s->read_idx, r + 1, __ATOMIC_RELEASE);
+    return 0;
+}
+
+int hal_stream_depth(long long handle)
+{
+    hal_stream_t *s = hal_stream_get(handle);
+    if (!s)
+        return stale();
+    uint64_t r = __atomic_load_n(&s->read_idx, __ATOMIC_ACQUIRE);
+    uint64_t w = __atomic_load_n(&s->write_idx, __ATOMIC_ACQUIRE);
+    return w >= r ? (int)(w - r) : 0;
+}
+
+int hal_stream_maxdepth(long long handle)
+{
+    hal_stream_t *s = hal_stream_get(handle);
+    return s ? s->depth : stale();
+}
+
+long long hal_stream_num_overruns(long long handle)
+{
+    hal_stream_t *s = hal_stream_get(handle);
+    return s ? (long long)__atomic_load_n(&s->num_overruns,
+                                          __ATOMIC_RELAXED)
+             : stale();
+}
+
+long long hal_stream_num_underruns(long long handle)
+{
+    hal_stream_t *s = hal_stream_get(handle);
+    return s ? (long long)__atomic_load_n(&s->num_underruns,
+                                          __ATOMIC_RELAXED)
+             : stale();
+}
+
+int hal_stream_nelem(long long handle)
+{
+    hal_stream_t *s = hal_stream_get(handle);
+    return s ? s->nelem : stale();
+}
+
+int hal_stream_elem_type(long long handle, int index)
+{
+    hal_stream_t *s = hal_stream_get(handle);
+    if (!s)
+        return stale();
+    if (index < 0 || index >= s->nelem)
+        return hal_fail(EINVAL, "stream '%s' has no value %d", s->o.name,
+                        index);
+    return s->types[index];
+}

@@ -1,0 +1,1 @@
+"""Command-line programs of halsdk (halsampler, halstreamer, ...)."""

@@ -1,0 +1,237 @@
+"""halstreamer: feed lines of numbers into a streamer FIFO.
+
+    halstreamer [-c CHAN] [FILENAME]
+
+Reads lines from FILENAME (default stdin) and writes each one as a record
+to the stream ``streamer.CHAN`` (made by ``loadrt streamer``) of the HAL
+instance named by ``$HALSDK_INSTANCE``.  A line holds one value per pin of
+the channel, separated by blanks, as C reads them: floats as ``strtod``
+(decimal, hex, inf, nan), integers in decimal as ``strtol``/``strtoul``
+(out-of-range values wrap to the pin width as they do in C), bits as
+the single character 0 or 1.
+Lines starting with ``#`` are skipped; extra fields are ignored.  A bad
+line is reported on stderr (``line N, field M: ...``, N counted from 0 as
+the reference does) and skipped.  When the FIFO is full it waits.  Exits
+with 0 at the end of the input, 1 on errors or when killed.
+"""
+
+from __future__ import annotations
+
+import re
+import signal
+import sys
+import time
+from collections.abc import Iterable, Sequence
+from typing import IO, Optional
+
+PROG = "halstreamer"
+POLL_S = 0.01
+
+_DEC = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?\Z")
+_HEX = re.compile(r"[+-]?0[xX]([0-9a-fA-F]+\.?[0-9a-fA-F]*|\.[0-9a-fA-F]+)"
+                  r"([pP][+-]?\d+)?\Z")
+_SPECIAL = re.compile(r"([+-]?)(inf|infinity|nan|nan\([0-9A-Za-z_]*\))\Z",
+                      re.IGNORECASE)
+_INT = re.compile(r"[+-]?\d+\Z")
+_WS = " \t\n\r\v\f"
+
+
+class LineError(ValueError):
+    """A field of an input line that C's parsing would reject."""
+
+    def __init__(self, field: int, what: str):
+        super().__init__(what)
+        self.field = field
+        self.what = what
+
+
+def parse_float(tok: str) -> Optional[float]:
+    """``strtod`` of a whole token, or None when it is not all a number."""
+    if _DEC.match(tok):
+        return float(tok)
+    if _HEX.match(tok):
+        body = tok if "p" in tok.lower() else tok + "p0"
+        return float.fromhex(body)
+    m = _SPECIAL.match(tok)
+    if m:
+        word = m.group(2).lower()
+        value = float("nan") if word.startswith("nan") else float("inf")
+        return -value if m.group(1) == "-" else value
+    return None
+
+
+def _c_signed(tok: str, bits: int) -> int:
+    """strtol (64-bit clamp) then a cast to a signed ``bits`` integer."""
+    v = max(-(1 << 63), min((1 << 63) - 1, int(tok, 10)))
+    v &= (1 << bits) - 1
+    return v - (1 << bits) if v >> (bits - 1) else v
+
+
+def _c_unsigned(tok: str, bits: int) -> int:
+    """strtoul (a minus sign negates modulo 2**64; overflow clamps to
+    ULONG_MAX) then a cast to an unsigned ``bits`` integer."""
+    v = int(tok, 10)
+    top = (1 << 64) - 1
+    if abs(v) > top:
+        v = top
+    return v & top & ((1 << bits) - 1)
+
+
+def parse_line(line: str, types: Sequence[int]) -> list:
+    """Values of one input line for a channel of ``types``; raises
+    :class:`LineError` the way the reference rejects a line."""
+    from halsdk import _core
+    values = []
+    pos, end = 0, len(line)
+    for i, t in enumerate(types):
+        while pos < end and line[pos] in _WS:
+            pos += 1
+        if pos >= end:
+            raise LineError(i, "premature end of line")
+        stop = pos
+        while stop < end and line[stop] not in _WS:
+            stop += 1
+        tok = line[pos:stop]
+        pos = stop
+        if t == _core.FLOAT:
+            v = parse_float(tok)
+            if v is None:
+                raise LineError(i, "bad character")
+            values.append(v)
+            continue
+        if t == _core.BIT:
+            if tok[0] not in "01":
+                raise LineError(i, "bit value not 0 or 1")
+            if len(tok) > 1:
+                raise LineError(i, "bad character")
+            values.append(int(tok))
+            continue
+        if not _INT.match(tok):
+            raise LineError(i, "bad character")
+        if t == _core.S32:
+            values.append(_c_signed(tok, 32))
+        elif t == _core.U32:
+            values.append(_c_unsigned(tok, 32))
+        elif t == _core.S64:
+            values.append(_c_signed(tok, 64))
+        else:
+            values.append(_c_unsigned(tok, 64))
+    return values
+
+
+class _Usage(Exception):
+    pass
+
+
+def _parse(argv: Sequence[str]) -> tuple[int, Optional[str]]:
+    chan, filename = 0, None
+    args = list(argv)
+    i = 0
+    while i < len(args):
+        a = args[i]
+        if a.startswith("-") and len(a) > 1:
+            if a[1] != "c":
+                raise _Usage(f"ERROR: unknown option '{a[1]}'")
+            value = a[2:]
+            if not value:
+                i += 1
+                if i >= len(args):
+                    raise _Usage("ERROR: option 'c' needs a value")
+                value = args[i]
+            try:
+                chan = int(value, 0)
+            except ValueError:
+                raise _Usage(f"ERROR: invalid value '{value}' for option "
+                             "'c'") from None
+            if chan < 0:
+                raise _Usage(f"ERROR: invalid channel {chan}")
+        else:
+            if filename is not None:
+                raise _Usage(f"ERROR: extra argument '{a}'")
+            filename = a
+        i += 1
+    return chan, filename
+
+
+def feed(stream, lines: Iterable[str], stop: list,
+         err: IO[str] = sys.stderr) -> bool:
+    """Write the records of ``lines`` to ``stream``, waiting while it is
+    full; False if ``stop`` became non-empty first."""
+    types = stream.types
+    room = stream.maxdepth
+    for lineno, line in enumerate(lines):
+        if line.startswith("#"):
+            continue
+        try:
+            values = parse_line(line, types)
+        except LineError as e:
+            err.write(f"line {lineno}, field {e.field}: {e.what}, "
+                      "skipping the line\n")
+            err.flush()
+            continue
+        while stream.depth >= room:
+            if stop:
+                return False
+            time.sleep(POLL_S)
+        if stop:
+            return False
+        stream.write(values)
+    return True
+
+
+def main(argv: Optional[Sequence[str]] = None) -> int:
+    """Entry point of the ``halstreamer`` program."""
+    if argv is None:
+        argv = sys.argv[1:]
+    try:
+        chan, filename = _parse(argv)
+    except _Usage as e:
+        print(e, file=sys.stderr)
+        return 1
+    stop: list = []
+
+    def on_signal(signum, frame):  # noqa: ARG001
+        stop.append(signum)
+
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(sig, on_signal)
+
+    from halsdk import _core, errors
+    from halsdk.hal import Hal
+    try:
+        hal = Hal(create=False)
+    except errors.HalError as e:
+        print(f"{PROG}: ERROR: cannot attach to the HAL instance: {e}",
+              file=sys.stderr)
+        return 1
+    name = f"streamer.{chan}"
+    try:
+        try:
+            stream = _core.stream_attach(name)
+        except errors.NotFoundError:
+            print(f"{PROG}: ERROR: stream '{name}' not found (is 'loadrt "
+                  f"streamer' loaded with at least {chan + 1} channel"
+                  f"{'s' if chan else ''}?)", file=sys.stderr)
+            return 1
+        try:
+            src = (open(filename, encoding="utf-8", errors="replace")
+                   if filename else sys.stdin)
+        except OSError as e:
+            print(f"{PROG}: ERROR: cannot open '{filename}': {e.strerror}",
+                  file=sys.stderr)
+            return 1
+        try:
+            return 0 if feed(stream, src, stop) else 1
+        except errors.StaleError:
+            print(f"{PROG}: ERROR: stream '{name}' was removed (streamer "
+                  "unloaded)", file=sys.stderr)
+            return 1
+        finally:
+            if filename:
+                src.close()
+    finally:
+        hal.close()
+
+
+if __name__ == "__main__":
+    sys.exit(main())
