@@ -14,6 +14,7 @@ from cpython.pycapsule cimport PyCapsule_New
 from cpython.ref cimport PyObject, Py_INCREF, Py_DECREF
 
 import os
+import re
 import sys
 import traceback
 
@@ -326,6 +327,8 @@ cdef object get_raw(int type, void *p):
     return (<uint64_t *>p)[0]
 
 
+_C_INTEGER = re.compile(r"\s*([+-]?)(0[xX][0-9a-fA-F]+|0[0-7]*|[1-9][0-9]*)\s*$")
+
 _INT_RANGE = {
     HALSDK_S32: (-(1 << 31), (1 << 31) - 1),
     HALSDK_U32: (0, (1 << 32) - 1),
@@ -334,15 +337,31 @@ _INT_RANGE = {
 }
 
 
+def c_integer(str text):
+    """An integer written as C's strtol(..., 0) reads it: ``0x`` hex, a
+    leading ``0`` octal, else decimal; no digit separators."""
+    m = _C_INTEGER.match(text)
+    if m is None:
+        raise ValueError(text)
+    sign, body = m.groups()
+    if body[:2].lower() == "0x":
+        v = int(body[2:], 16)
+    elif len(body) > 1 and body[0] == "0":
+        v = int(body[1:], 8)
+    else:
+        v = int(body, 10)
+    return -v if sign == "-" else v
+
+
 def parse_value(int type, value, str what):
     """Convert a Python value or a halcmd-style string for a HAL type."""
     tname = TYPE_NAMES.get(type, "?")
     if type == HALSDK_BIT:
         if isinstance(value, str):
             s = value.strip()
-            if s in ("1", "TRUE", "true", "True"):
+            if s == "1" or s.lower() == "true":
                 return True
-            if s in ("0", "FALSE", "false", "False"):
+            if s == "0" or s.lower() == "false":
                 return False
         elif isinstance(value, (bool, int)) and value in (0, 1):
             return bool(value)
@@ -354,13 +373,19 @@ def parse_value(int type, value, str what):
         try:
             if isinstance(value, bool):
                 return float(value)
-            return float(value.strip() if isinstance(value, str) else value)
+            if isinstance(value, str):
+                # as C's strtod reads it: no digit separators; hex floats
+                s = value.strip()
+                if "_" in s:
+                    raise ValueError
+                return float.fromhex(s) if "0x" in s.lower() else float(s)
+            return float(value)
         except (TypeError, ValueError):
             raise _errors.InvalidError(
                 f"value '{value}' for {what} is not a float") from None
     try:
         if isinstance(value, str):
-            v = int(value.strip(), 0)
+            v = c_integer(value)
         elif isinstance(value, float):
             if not value.is_integer():
                 raise ValueError
@@ -593,6 +618,13 @@ cdef class Signal(Item):
         if s.writers > 0:
             raise _errors.ConflictError(
                 f"signal '{self._name}' already has writer(s)")
+        v = parse_value(s.type, v, f"signal '{self._name}'")
+        put_raw(s.type, &s.value, v)
+
+    def write(self, v):
+        """Write the value whatever its writers and the lock: for tools
+        (halcmd's ``sets``, which the reference does not lock)."""
+        cdef hal_sig_t *s = <hal_sig_t *>self.rec()
         v = parse_value(s.type, v, f"signal '{self._name}'")
         put_raw(s.type, &s.value, v)
 

@@ -135,12 +135,14 @@ def _convert(comp: str, pname: str, kind: str, raw: Any) -> Any:
             parts = [raw]
         return [_convert(comp, pname, kind.lower(), p) for p in parts]
     if kind == "s":
+        if isinstance(raw, (list, tuple)):     # names=["a", "b"]
+            return ",".join(map(str, raw))
         return str(raw)
     try:
         if kind == "f":
             return float(raw)
         if isinstance(raw, str):
-            return c_integer(raw)
+            return _core.c_integer(raw)
         if isinstance(raw, bool) or not isinstance(raw, int):
             raise ValueError
         return raw
@@ -148,19 +150,6 @@ def _convert(comp: str, pname: str, kind: str, raw: Any) -> Any:
         what = "a number" if kind == "f" else "an integer"
         raise InvalidError(f"{comp}: parameter {pname}={raw!r} is not "
                            f"{what}") from None
-
-
-def c_integer(text: str) -> int:
-    """An integer as C's strtol(..., 0) reads a load line: ``0x`` hex, a
-    leading ``0`` octal, else decimal."""
-    t = text.strip()
-    sign = -1 if t[:1] == "-" else 1
-    body = t[1:] if t[:1] in "+-" else t
-    if body[:2].lower() == "0x":
-        return sign * int(body[2:], 16)
-    if len(body) > 1 and body[0] == "0":
-        return sign * int(body[1:], 8)
-    return sign * int(body, 10)
 
 
 def parse_modparams(name: str, module: ModuleType, args: tuple,

@@ -200,5 +200,4 @@ def test_component_from_entry_point_group(hal, tmp_path, monkeypatch):
                                         ("010", 8), ("-0x10", -16),
                                         ("0", 0), ("+7", 7)])
 def test_load_line_integers_read_as_c_does(text, value):
-    from halsdk.loader import c_integer
-    assert c_integer(text) == value
+    assert _core.c_integer(text) == value

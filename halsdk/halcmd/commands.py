@@ -79,14 +79,9 @@ def hal_error(text: str, *messages: str) -> CommandError:
 
 
 def find(kind: str, name: str):
-    """A pin, param or signal by name; pins and params also by the
-    original name they had before an alias."""
-    item = _core.find(kind, name)
-    if item is None and kind in ("pin", "param"):
-        for it in _core.items(kind):
-            if it.alias_of == name:
-                return it
-    return item
+    """A pin, param or signal by name (pins and params also by the name
+    they had before an alias: the core looks those up too)."""
+    return _core.find(kind, name)
 
 
 class Quit(Exception):
@@ -456,16 +451,7 @@ class Executor:
             raise CommandError(
                 f"value '{args[1]}' invalid for {_value_word(sig.type)}",
                 "sets failed") from None
-        # the reference's sets ignores locks; the core's setter honours
-        # them, so the lock is lifted around the write
-        level = _core.get_lock()
-        if level:
-            _core.set_lock(0)
-        try:
-            sig.value = value
-        finally:
-            if level:
-                _core.set_lock(level)
+        sig.write(value)            # the reference's sets ignores locks
 
     def cmd_gets(self, args: list[str]) -> None:
         sig = self._signal(args[0])

@@ -292,7 +292,18 @@ static void *find_in_space(int space, const char *name)
 void *hal_find(int kind, const char *name)
 {
     hal_obj_t *o = find_in_space(name_space(kind), name);
-    return o && o->kind == kind ? o : NULL;
+    if (o && o->kind == kind)
+        return o;
+    /* an aliased pin or param still answers to its original name */
+    if ((kind == K_PIN || kind == K_PARAM) && hal_map.hdr->naliases > 0) {
+        for (hoff_t x = hal_map.hdr->list_head[kind]; x;) {
+            hal_item_t *it = SHMPTR(x);
+            if (it->oldname && strcmp(SHMPTR(it->oldname), name) == 0)
+                return it;
+            x = it->o.next;
+        }
+    }
+    return NULL;
 }
 
 static void index_insert(hal_obj_t *o)
@@ -713,6 +724,7 @@ static int rename_item(hal_obj_t *o, hoff_t *oldname, const char *alias)
                             "'%s'", o->name);
         memcpy(keep, o->name, HAL_NAME_SIZE);
         *oldname = SHMOFF(keep);
+        hal_map.hdr->naliases++;
     }
     index_remove(o);
     snprintf(o->name, sizeof(o->name), "%s", alias);
@@ -772,6 +784,7 @@ int hal_unalias(int kind, const char *alias)
     index_insert(o);
     hal_free(orig);
     *oldname = 0;
+    hal_map.hdr->naliases--;
     hal_map.hdr->serial++;
 out:
     hal_unlock();
@@ -822,6 +835,18 @@ static void unlink_locked(hal_pin_t *p)
     else
         s->bidirs--;
     hal_map.hdr->serial++;
+}
+
+/* remove a pin or param: unlinked, alias name freed; lock held */
+static void item_delete(hal_item_t *it)
+{
+    if (it->o.kind == K_PIN && ((hal_pin_t *)it)->signal)
+        unlink_locked((hal_pin_t *)it);
+    if (it->oldname) {
+        hal_free(SHMPTR(it->oldname));
+        hal_map.hdr->naliases--;
+    }
+    obj_delete(&it->o);
 }
 
 int hal_signal_delete(const char *name)
@@ -1139,15 +1164,12 @@ static void thread_delete_locked(hal_thread_t *t)
     drop_entries(t, 0);
     hal_comp_t *c = SHMPTR(t->comp);
     hoff_t co = t->comp;
-    FOR_EACH(K_PIN, hal_pin_t, p)
-        if (p->comp == co) {
-            if (p->signal)
-                unlink_locked(p);
-            obj_delete(&p->o);
-        }
-    FOR_EACH(K_PARAM, hal_param_t, p)
-        if (p->comp == co)
-            obj_delete(&p->o);
+    FOR_EACH(K_PIN, hal_item_t, it)
+        if (it->comp == co)
+            item_delete(it);
+    FOR_EACH(K_PARAM, hal_item_t, it)
+        if (it->comp == co)
+            item_delete(it);
     free_owned(&c->mem);
     obj_delete(&c->o);
     obj_delete(&t->o);
@@ -1283,20 +1305,12 @@ static void delete_items_of(hoff_t comp, hoff_t inst)
     FOR_EACH(K_FUNCT, hal_funct_t, f)
         if (f->comp == comp && (!inst || f->inst == inst))
             obj_delete(&f->o);
-    FOR_EACH(K_PIN, hal_pin_t, p)
-        if (p->comp == comp && (!inst || p->inst == inst)) {
-            if (p->signal)
-                unlink_locked(p);
-            if (p->oldname)
-                hal_free(SHMPTR(p->oldname));
-            obj_delete(&p->o);
-        }
-    FOR_EACH(K_PARAM, hal_param_t, p)
-        if (p->comp == comp && (!inst || p->inst == inst)) {
-            if (p->oldname)
-                hal_free(SHMPTR(p->oldname));
-            obj_delete(&p->o);
-        }
+    FOR_EACH(K_PIN, hal_item_t, it)
+        if (it->comp == comp && (!inst || it->inst == inst))
+            item_delete(it);
+    FOR_EACH(K_PARAM, hal_item_t, it)
+        if (it->comp == comp && (!inst || it->inst == inst))
+            item_delete(it);
     hal_stream_delete_of(comp, inst);
 }
 
@@ -1468,6 +1482,11 @@ static void recover_after_dead_holder(void)
         h->list_tail[k] = prev;
         h->count[k] = n;
     }
+    h->naliases = 0;
+    FOR_EACH(K_PIN, hal_item_t, it)
+        h->naliases += it->oldname != 0;
+    FOR_EACH(K_PARAM, hal_item_t, it)
+        h->naliases += it->oldname != 0;
     FOR_EACH(K_SIG, hal_sig_t, s)
         s->readers = s->writers = s->bidirs = 0;
     FOR_EACH(K_PIN, hal_pin_t, p) {

@@ -210,6 +210,7 @@ typedef struct {
     int64_t sim_time;
     int32_t threads_running;
     int32_t recovered;          /* times a dead lock holder was cleaned up */
+    int32_t naliases;           /* pins and params that have an alias */
 } hal_header_t;
 
 /* a mapping of an instance in this process */
