@@ -29,6 +29,10 @@ PACKAGE_DIR = os.path.dirname(os.path.abspath(__file__))
 INCLUDE_DIR = os.path.join(PACKAGE_DIR, "include")
 C_ENTRY = os.path.join(PACKAGE_DIR, "src", "c_module.c")
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
+_DIAG = re.compile(r"^\S[^:]*:\d+:(\d+:)? |^In file included|^\s+\d* *\||"
+                   r"[Ee]rror")
+_NOISE = re.compile(r"^\s*raise |^(distutils|setuptools)\.|Error: command|"
+                    r"^Traceback|^\s+File ")
 _FLAGS = ["-O2", "-std=gnu11", "-Wall", "-Wno-unused-function",
           "-Wno-unused-variable"]
 
@@ -52,17 +56,24 @@ def extension_suffix() -> str:
     return importlib.machinery.EXTENSION_SUFFIXES[0]
 
 
-def _digest(paths: Sequence[str], extra: Sequence[str]) -> str:
+def _digest(paths: Sequence[str], extra: Sequence[str],
+            header_dirs: Sequence[str] = ()) -> str:
+    """Hash of everything a build reads: sources, the headers of halsdk
+    and of the given folders, the entry code, Python and the flags."""
     h = hashlib.sha256()
     for p in paths:
         h.update(p.encode() if not os.path.isfile(p) else b"")
         if os.path.isfile(p):
             with open(p, "rb") as f:
                 h.update(f.read())
-    for folder in (INCLUDE_DIR,):
+    for folder in (INCLUDE_DIR, *header_dirs):
+        if not os.path.isdir(folder):
+            continue
         for name in sorted(os.listdir(folder)):
-            with open(os.path.join(folder, name), "rb") as f:
-                h.update(name.encode() + f.read())
+            path = os.path.join(folder, name)
+            if name.endswith((".h", ".pxd", ".pxi")) and os.path.isfile(path):
+                with open(path, "rb") as f:
+                    h.update(name.encode() + f.read())
     for p in (C_ENTRY, os.path.join(PACKAGE_DIR, "hal.pxd")):
         with open(p, "rb") as f:
             h.update(f.read())
@@ -124,7 +135,8 @@ def build_component(source: str, out_dir: Optional[str] = None,
     extras = [os.path.abspath(s) for s in extra_sources]
     cflags = _FLAGS + list(extra_compile_args)
     key = _digest([source] + extras,
-                  [name, *cflags, *extra_link_args, *include_dirs])
+                  [name, *cflags, *extra_link_args, *include_dirs],
+                  [os.path.dirname(source), *include_dirs])
     target_dir = os.path.join(cache_dir(), key)
     built = os.path.join(target_dir, name + extension_suffix())
     if force or not os.path.isfile(built):
@@ -174,8 +186,10 @@ def _compile(source: str, extras: list[str], name: str, cython: bool,
         out = os.path.join(tmp, "lib", name + extension_suffix())
         if proc.returncode != 0 or not os.path.isfile(out):
             lines = (proc.stdout + proc.stderr).splitlines()
-            relevant = [ln for ln in lines if "error" in ln.lower()
-                        or ln.startswith(("warning", os.path.sep))] or lines
+            # the compiler's diagnostics with their source lines and
+            # carets; not the build tools' own traceback
+            relevant = [ln for ln in lines if _DIAG.search(ln)
+                        and not _NOISE.search(ln)] or lines
             raise BuildError(f"{source}: build failed:\n" +
                              "\n".join(relevant[-40:]))
         staging = target_dir + f".{os.getpid()}.tmp"
