@@ -38,7 +38,7 @@ components = [
 
 setup(
     packages=["halsdk", "halsdk.compat", "halsdk.demo", "halsdk.halcmd",
-              "halsdk.components", "halsdk.tools"],
+              "halsdk.components", "halsdk.tools", "halcompile"],
     package_dir={"halsdk.components": "components"},
     ext_modules=cythonize([core] + components, language_level=3, quiet=True,
                           include_path=["."]),

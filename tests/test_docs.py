@@ -20,7 +20,8 @@ from halsdk.build import build_component
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 DOCS = os.path.join(ROOT, "docs")
-PAGES = ["index", "concepts", "components", "halcmd", "python-api",
+PAGES = ["index", "concepts", "components", "halcmd", "halcompile",
+         "python-api",
          "cython-components",
          "c-components", "design", "compat", "benchmarks"]
 

@@ -13,6 +13,7 @@ def test_ruff_clean():
     ruff = shutil.which("ruff")
     assert ruff, "ruff is part of the test extras: pip install '.[test]'"
     proc = subprocess.run([ruff, "check", "--no-cache", "halsdk", "tests",
-                           "bench", "docs", "components", "setup.py"],
+                           "bench", "docs", "components", "halcompile",
+                           "setup.py"],
                           cwd=ROOT, capture_output=True, text=True)
     assert proc.returncode == 0, proc.stdout + proc.stderr

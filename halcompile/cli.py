@@ -1,0 +1,194 @@
+"""The ``halcompile`` command.
+
+Modes (one per run; ``--preprocess`` is the default):
+
+``--preprocess``  write the C file generated from each ``.comp`` next to it
+                  (or to ``-o FILE``)
+``--compile``     build each ``.comp`` or hand-written ``.c`` into a
+                  component module in the current folder (or the folder
+                  ``-o DIR``); ``loadrt`` finds it through ``HALSDK_PATH``
+``--install``     build into the user component folder, where ``loadrt``
+                  finds it with no set-up
+
+User errors print ``file:line:col: message`` (or the compiler's messages,
+which point into the ``.comp`` file) and exit with status 1.
+"""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import os
+import re
+import shlex
+import sys
+import tempfile
+from collections.abc import Sequence
+from typing import Optional
+
+from halcompile.gen_c import MAX_PERSONALITIES, generate
+from halcompile.model import Component
+from halcompile.parser import CompError, parse_file
+
+#: flags of every generated module: its symbols stay private to it
+_PRIVATE = ["-fvisibility=hidden"]
+#: lines of the build tool's traceback, not of the compiler
+_NOISE = re.compile(r"^\s*raise |^(distutils|setuptools)\.|"
+                    r"DistutilsExecError|CompileError|LinkError")
+
+
+class UsageError(Exception):
+    pass
+
+
+def _arg_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="halcompile",
+        description="Build HAL component modules from .comp and .c files.")
+    mode = p.add_mutually_exclusive_group()
+    for flag in ("compile", "install", "preprocess", "document",
+                 "view-doc", "install-doc"):
+        mode.add_argument(f"--{flag}", dest="mode", action="store_const",
+                          const=flag.replace("-", "_"))
+    p.add_argument("-o", "--of", dest="output", metavar="OUT",
+                   help="--preprocess: the C file to write; --compile: the "
+                        "folder that receives the module (one input only "
+                        "for --preprocess)")
+    p.add_argument("-u", "--userspace", action="store_true",
+                   help="build userspace components (not supported yet)")
+    p.add_argument("--extra-compile-args", default="",
+                   help="more C compiler arguments (one string)")
+    p.add_argument("--extra-link-args", default="",
+                   help="more linker arguments (one string)")
+    p.add_argument("--personalities", type=int, default=MAX_PERSONALITIES,
+                   help="size of the personality modparam of components "
+                        "with personality (default: %(default)s)")
+    p.add_argument("files", nargs="+", metavar="FILE")
+    return p
+
+
+def main(argv: Optional[Sequence[str]] = None) -> int:
+    """Run halcompile with ``argv`` (default: ``sys.argv[1:]``); returns
+    the exit status (0, or 1 after a user error)."""
+    args = _arg_parser().parse_args(argv)
+    mode = args.mode or "preprocess"
+    try:
+        if mode in ("document", "view_doc", "install_doc"):
+            raise UsageError(f"--{mode.replace('_', '-')} is not supported "
+                             "yet")
+        if args.userspace:
+            raise UsageError("--userspace is not supported yet")
+        if args.personalities < 1:
+            raise UsageError("--personalities must be at least 1")
+        if args.output and mode == "preprocess" and len(args.files) > 1:
+            raise UsageError("-o takes one input file with --preprocess")
+        for path in args.files:
+            process(path, mode, args.output,
+                    shlex.split(args.extra_compile_args),
+                    shlex.split(args.extra_link_args), args.personalities)
+    except (CompError, UsageError) as exc:
+        print(f"{exc}" if isinstance(exc, CompError)
+              else f"halcompile: {exc}", file=sys.stderr)
+        return 1
+    except _Failed as exc:
+        print(str(exc), file=sys.stderr)
+        return 1
+    except OSError as exc:
+        print(f"halcompile: {exc}", file=sys.stderr)
+        return 1
+    return 0
+
+
+class _Failed(Exception):
+    """A build failed; the message is what the user needs to see."""
+
+
+def process(path: str, mode: str, output: Optional[str] = None,
+            cflags: Sequence[str] = (), ldflags: Sequence[str] = (),
+            personalities: int = MAX_PERSONALITIES) -> str:
+    """Preprocess, compile or install one file; returns what was
+    written."""
+    if not os.path.isfile(path):
+        raise UsageError(f"{path}: no such file")
+    ext = os.path.splitext(path)[1]
+    if ext == ".c":
+        if mode == "preprocess":
+            raise UsageError(f"{path}: a .c file needs --compile or "
+                             "--install")
+        return _build(path, None, mode, output, cflags, ldflags)
+    if ext != ".comp":
+        raise UsageError(f"{path}: expected a .comp or .c file")
+    comp = parse_file(path)
+    if mode == "preprocess":
+        out = output or os.path.splitext(path)[0] + ".c"
+        text = generate(comp, os.path.basename(out), personalities)
+        with open(out, "w", encoding="utf-8") as f:
+            f.write(text)
+        return out
+    return _build(path, comp, mode, output, cflags, ldflags, personalities)
+
+
+def _build(path: str, comp: Optional[Component], mode: str,
+           output: Optional[str], cflags: Sequence[str],
+           ldflags: Sequence[str],
+           personalities: int = MAX_PERSONALITIES) -> str:
+    from halsdk.build import BuildError, build_component
+    from halsdk.loader import user_component_dir
+
+    out_dir = user_component_dir() if mode == "install" else \
+        (output or os.getcwd())
+    includes = [os.path.dirname(os.path.abspath(path))]
+    flags = _PRIVATE + list(cflags)
+    try:
+        if comp is None:
+            name = os.path.splitext(os.path.basename(path))[0]
+            dest = build_component(path, out_dir=out_dir, name=name,
+                                   include_dirs=includes,
+                                   extra_compile_args=flags,
+                                   extra_link_args=list(ldflags))
+        else:
+            flags += shlex.split(str(comp.option("extra_compile_args",
+                                                 "")))
+            ldflags = list(ldflags) + shlex.split(
+                str(comp.option("extra_link_args", "")))
+            deps = _local_headers_digest(comp, includes[0])
+            if deps:
+                flags.append(f"-DHALCOMPILE_DEPS=0x{deps}")
+            with tempfile.TemporaryDirectory(prefix="halcompile-") as tmp:
+                c_file = os.path.join(tmp, comp.name + ".c")
+                with open(c_file, "w", encoding="utf-8") as f:
+                    f.write(generate(comp, comp.name + ".c", personalities))
+                dest = build_component(c_file, out_dir=out_dir,
+                                       name=comp.name,
+                                       include_dirs=includes,
+                                       extra_compile_args=flags,
+                                       extra_link_args=list(ldflags))
+    except BuildError as exc:
+        lines = str(exc).splitlines()
+        body = "\n".join(ln for ln in lines[1:] if not _NOISE.search(ln)) \
+            if len(lines) > 1 else str(exc)
+        raise _Failed(f"{path}: compilation failed:\n{body}") from None
+    print(dest)
+    return dest
+
+
+def _local_headers_digest(comp: Component, folder: str) -> str:
+    """A hash of the quoted headers found next to the .comp, so that a
+    changed header makes a new build (the build cache hashes only the
+    generated C file)."""
+    names = [inc[1:-1] for inc in comp.includes if inc.startswith('"')]
+    names += re.findall(r'#\s*include\s*"([^"]+)"', comp.code)
+    h = hashlib.sha256()
+    found = False
+    for name in sorted(set(names)):
+        p = os.path.join(folder, name)
+        if os.path.isfile(p):
+            found = True
+            h.update(name.encode())
+            with open(p, "rb") as f:
+                h.update(f.read())
+    return h.hexdigest()[:16] if found else ""
+
+
+if __name__ == "__main__":      # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,12 @@
+component hcclamp "Clamp a value; min_ and max_ are HAL params min and max";
+pin in float in;
+pin out float out;
+param rw float min_ = -1e20;
+param rw float max_ = 1e20;
+function _;
+license "GPL";
+;;
+double v = in;
+if (v < min_) v = min_;
+if (v > max_) v = max_;
+out = v;
