@@ -16,7 +16,6 @@ from halcompile.model import c_identifier, hal_format, hal_identifier
 from halsdk.build import extension_suffix
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(HERE)
 COMPS = os.path.join(HERE, "comps")
 GOOD = ["hcddt", "hcmux2", "hcarrays", "hcsetup", "hcsingle", "hcsingle2",
         "hclogic", "hcdata", "hal_hcloop", "hcrtapp", "hcnames", "hcdelay",
@@ -27,7 +26,13 @@ PERIOD = 1_000_000
 def halcompile(*args: str, cwd: str) -> subprocess.CompletedProcess:
     """Run ``python -m halcompile`` the way a user runs the command."""
     env = dict(os.environ)
-    env["PYTHONPATH"] = ROOT + os.pathsep + env.get("PYTHONPATH", "")
+    # the packages this test imported (installed, or an editable tree):
+    # never the repository root, which holds no compiled core in a clone
+    import halcompile as hc
+    import halsdk
+    dirs = {os.path.dirname(os.path.dirname(m.__file__)) for m in (hc, halsdk)}
+    env["PYTHONPATH"] = os.pathsep.join([*sorted(dirs),
+                                         env.get("PYTHONPATH", "")])
     return subprocess.run([sys.executable, "-m", "halcompile", *args],
                           cwd=cwd, env=env, capture_output=True, text=True)
 
