@@ -27,12 +27,15 @@ options:
   -V             very verbose
   -e             echo the commands read from a file
   -h             this help
+  --check FILE   check FILE's netlist without running it (see docs)
 """
 
 _HALRUN_USAGE = """\
-Usage:  halrun [-I] [-U] [halcmd options] [-f] [filename.hal]
+Usage:  halrun [-I] [-U] [halcmd options] [-f] [filename.hal|filename.ini]
   -I   run an interactive halcmd after the file, before removing HAL
   -U   remove HAL instances left behind by dead processes and exit
+  --check FILE  check FILE's netlist without running it
+  an INI file with [HAL]TWOPASS runs its [HAL]HALFILEs in two passes
   (other options are those of halcmd)
 """
 
@@ -47,6 +50,7 @@ class _Options:
         self.echo = False
         self.interactive_after = False
         self.cleanup = False
+        self.check = False
         self.words: list[str] = []
 
 
@@ -60,6 +64,10 @@ def _parse(argv: list[str], prog: str) -> _Options:
         if arg == "--":
             i += 1
             break
+        if arg == "--check":
+            opts.check = True
+            i += 1
+            continue
         if not arg.startswith("-") or arg == "-":
             break
         letters = arg[1:]
@@ -174,6 +182,12 @@ def _interactive(ex: Executor) -> None:
 def _run(ex: Executor, opts: _Options, prog: str) -> int:
     """Run the file, the command words or the prompt; exit status."""
     try:
+        if opts.file is not None and prog == "halrun" and \
+                opts.file.endswith(".ini"):
+            status = _twopass(ex, opts.file)
+            if opts.interactive_after:
+                _interactive(ex)
+            return status
         if opts.file is not None:
             if opts.file == "-":
                 ex.run_lines(sys.stdin, "<stdin>")
@@ -188,6 +202,32 @@ def _run(ex: Executor, opts: _Options, prog: str) -> int:
     except Quit:
         pass
     return 1 if ex.errors else 0
+
+
+def _twopass(ex: Executor, path: str) -> int:
+    """``halrun FILE.ini``: twopass loading, as the reference does it."""
+    from halsdk.halcmd import twopass
+    try:
+        if not twopass.is_twopass_ini(path):
+            print("halrun: An INI file may only be used if it specifies "
+                  "[HAL]TWOPASS")
+            return 1
+    except OSError as exc:
+        print(f"halrun: cannot read '{path}': {exc.strerror}",
+              file=sys.stderr)
+        return 1
+    return twopass.run(ex, path)
+
+
+def _check(opts: _Options, prog: str) -> int:
+    """``--check FILE``: the netlist checker (no instance is used)."""
+    from halsdk.halcmd import check
+    path = opts.file if opts.file not in (None, "-") else (
+        opts.words[0] if opts.words else None)
+    if path is None:
+        print(f"{prog}: --check needs a HAL file", file=sys.stderr)
+        return 2
+    return check.main(path, ini=opts.ini)
 
 
 def _teardown(hal, ex: Executor, opts: _Options) -> None:
@@ -226,6 +266,8 @@ def halcmd_main(argv: Optional[list[str]] = None) -> int:
     from halsdk.errors import HalError
     argv = sys.argv[1:] if argv is None else argv
     opts = _parse(argv, "halcmd")
+    if opts.check:
+        return _check(opts, "halcmd")
     try:
         hal = Hal(create=False)
     except HalError as exc:
@@ -251,6 +293,8 @@ def halrun_main(argv: Optional[list[str]] = None) -> int:
     if opts.cleanup:
         halsdk.cleanup()
         return 0
+    if opts.check:
+        return _check(opts, "halrun")
     if opts.file is None and opts.words:
         # halrun FILE: the file name may come without -f
         opts.file, opts.words = opts.words[0], opts.words[1:]

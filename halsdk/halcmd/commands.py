@@ -59,6 +59,11 @@ ARG_COUNTS: dict[str, tuple[int, Optional[int]]] = {
     "save": (0, 2), "status": (0, 1), "help": (0, 1), "debug": (1, 1),
     "print": (0, None), "setexact_for_test_suite_only": (0, 0),
 }
+# longest name the reference HAL accepts (its HAL_NAME_LEN)
+REFERENCE_NAME_LEN = 47
+# kinds of objects whose new names are reported to Executor.created()
+_CREATED_KINDS = ("component", "instance", "pin", "param", "function",
+                  "thread")
 # commands whose arrows are dropped before counting arguments
 _DROP_ARROWS = ("linkps", "linksp", "linkpp")
 
@@ -130,13 +135,15 @@ class Executor:
     :param verbose: 0 quiet (``-Q``: nothing at all is -1), 1 ``-v``.
     :param ini: INI file for ``[SECTION]KEY`` substitution.
     :param echo: start with echo on (``-e``).
+    :param warn_long_names: print a warning when a command creates a name
+        longer than the reference's 47 characters (never with ``-Q``).
     """
 
     def __init__(self, hal, out: Optional[Out] = None,
                  err: Optional[Out] = None, *, keep_going: bool = False,
                  script: bool = False, verbose: int = 0,
                  ini: Optional[str] = None, echo: bool = False,
-                 register: bool = True):
+                 register: bool = True, warn_long_names: bool = True):
         self.hal = hal
         if verbose < 0:
             out = _discard
@@ -146,6 +153,7 @@ class Executor:
         self.verbose = verbose
         self.ini = IniFile(ini) if ini else None
         self.echo = echo
+        self.warn_long_names = warn_long_names
         self.shower = Shower(self.out, script)
         self.filename: Optional[str] = None
         self.lineno = 0
@@ -273,6 +281,35 @@ class Executor:
 
     # ------------------------------------------------------------ helpers
 
+    def created(self, kind: str, names: list[str]) -> None:
+        """Hook called with the names of the objects a command created.
+
+        Warns (on the error stream, as ``file:line: Warning: ...``) about
+        names the reference could not hold; subclasses (the netlist
+        checker) record more.
+        """
+        if self.verbose < 0 or not self.warn_long_names:
+            return
+        for name in names:
+            if len(name) > REFERENCE_NAME_LEN:
+                self.error(f"Warning: {kind} name '{name}' is {len(name)} "
+                           f"characters long; the reference HAL accepts at "
+                           f"most {REFERENCE_NAME_LEN}")
+
+    @staticmethod
+    def _counts() -> dict[str, int]:
+        return dict(_core.info()["counts"])
+
+    def _report_new(self, before: dict[str, int]) -> None:
+        """Report the objects created since the ``before`` counts (the
+        core lists objects in creation order)."""
+        after = _core.info()["counts"]
+        for kind in _CREATED_KINDS:
+            added = after[kind] - before[kind]
+            if added > 0:
+                self.created(kind, [it.name for it
+                                    in _core.items(kind)[-added:]])
+
     def _locked(self, bit: int) -> bool:
         return bool(_core.get_lock() & bit)
 
@@ -297,11 +334,13 @@ class Executor:
                                f"insmod for {args[0]} failed, returned -1")
         if self.comp_id is not None:
             self.register()
+        before = self._counts()
         try:
             self.hal.loadrt(args[0], *args[1:])
         except HalError as exc:
             raise CommandError(f"insmod for {args[0]} failed, returned -1",
                                lines=[f"{args[0]}: {exc}"]) from None
+        self._report_new(before)
         self.info(f"Component '{args[0]}' ready")
         self.info(f"Realtime module '{args[0]}' loaded")
 
@@ -325,10 +364,12 @@ class Executor:
                 if c.realtime and not c.name.startswith("__")}
 
     def cmd_newinst(self, args: list[str]) -> None:
+        before = self._counts()
         try:
             self.hal.newinst(args[0], args[1], *args[2:])
         except HalError as exc:
             raise CommandError(f"newinst failed: {exc}") from None
+        self._report_new(before)
 
     def cmd_delinst(self, args: list[str]) -> None:
         try:
@@ -428,6 +469,7 @@ class Executor:
             _core.signal_new(name, t)
         except HalError as exc:
             raise hal_error(str(exc), "newsig failed") from None
+        self.created("signal", [name])
 
     def cmd_delsig(self, args: list[str]) -> None:
         name = args[0]
@@ -537,6 +579,7 @@ class Executor:
             raise hal_error(f"pin '{second}' not found", "linkpp failed")
         if _core.find("signal", first) is None:
             _core.signal_new(first, pin.type)
+            self.created("signal", [first])
         self._link(first, first, "linkpp")
         self._link(second, first, "linkpp")
 
@@ -597,6 +640,7 @@ class Executor:
                 hal_error("link called while HAL locked", "link failed")
         if sig is None:
             _core.signal_new(signame, stype)
+            self.created("signal", [signame])
         for pin in handles:
             if pin.signal is None:
                 _core.link(pin.name, signame)
@@ -684,6 +728,7 @@ class Executor:
             _core.alias(kind, item.name, alias)
         except HalError as exc:
             raise hal_error(str(exc), "alias failed") from None
+        self.created(kind, [alias])
         self.info(f"{kind} '{name}' aliased to '{alias}'")
 
     def cmd_unalias(self, args: list[str]) -> None:
