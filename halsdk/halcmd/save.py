@@ -144,7 +144,8 @@ class Saver:
     def unconnected(self) -> None:
         self.out("# unconnected pin values\n")
         for pin in sorted_items("pin"):
-            if pin.direction == _core.IN and pin.signal is None:
+            # I/O pins are inputs too (the IN bit is set in IO)
+            if pin.direction & _core.IN and pin.signal is None:
                 self.out(f"setp {pin.name} "
                          f"{value_cell(pin.type, pin.value)}\n")
 
