@@ -44,6 +44,7 @@ class _Options:
     def __init__(self) -> None:
         self.file: Optional[str] = None
         self.ini: Optional[str] = None
+        self.release_only = False
         self.keep_going = False
         self.verbose = 0
         self.script = False
@@ -101,7 +102,9 @@ def _parse(argv: list[str], prog: str) -> _Options:
             elif c == "e":
                 opts.echo = True
             elif c == "R":
-                pass        # the core's mutex is robust: nothing to release
+                # release the HAL mutex and exit: the core's mutex is
+                # robust, so there is nothing to release
+                opts.release_only = True
             elif c == "I" and prog == "halrun":
                 opts.interactive_after = True
             elif c == "U" and prog == "halrun":
@@ -219,6 +222,18 @@ def _twopass(ex: Executor, path: str) -> int:
     return twopass.run(ex, path)
 
 
+def _ini_missing(opts: _Options) -> bool:
+    """-i with a file that cannot be read: the reference's message."""
+    if opts.ini is None:
+        return False
+    try:
+        with open(opts.ini, encoding="utf-8", errors="replace"):
+            return False
+    except OSError:
+        print(f"Could not open INI file '{opts.ini}'", file=sys.stderr)
+        return True
+
+
 def _check(opts: _Options, prog: str) -> int:
     """``--check FILE``: the netlist checker (no instance is used)."""
     from halsdk.halcmd import check
@@ -266,6 +281,10 @@ def halcmd_main(argv: Optional[list[str]] = None) -> int:
     from halsdk.errors import HalError
     argv = sys.argv[1:] if argv is None else argv
     opts = _parse(argv, "halcmd")
+    if opts.release_only:
+        return 0
+    if _ini_missing(opts):
+        return 1
     if opts.check:
         return _check(opts, "halcmd")
     try:
@@ -293,6 +312,10 @@ def halrun_main(argv: Optional[list[str]] = None) -> int:
     if opts.cleanup:
         halsdk.cleanup()
         return 0
+    if opts.release_only:
+        return 0
+    if _ini_missing(opts):
+        return 1
     if opts.check:
         return _check(opts, "halrun")
     if opts.file is None and opts.words:

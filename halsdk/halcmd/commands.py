@@ -46,7 +46,7 @@ _INT = re.compile(r"\s*([-+]?)(0[xX][0-9a-fA-F]+|0[0-7]*|[1-9]\d*)$")
 
 # name: (least, most) argument counts (most None: any number)
 ARG_COUNTS: dict[str, tuple[int, Optional[int]]] = {
-    "addf": (2, None), "alias": (3, 3), "delf": (1, 2), "delsig": (1, 1),
+    "addf": (2, None), "alias": (3, 3), "delf": (0, 2), "delsig": (1, 1),
     "echo": (0, 0), "unecho": (0, 0), "getp": (1, 1), "gets": (1, 1),
     "linkpp": (2, 2), "linkps": (2, 2), "linksp": (2, 2), "list": (1, None),
     "loadrt": (1, None), "lock": (0, 1), "unlock": (0, 1), "net": (1, None),
@@ -57,7 +57,7 @@ ARG_COUNTS: dict[str, tuple[int, Optional[int]]] = {
     "delinst": (1, 1), "quit": (0, None), "exit": (0, None),
     "loadusr": (0, None), "waitusr": (1, 1), "unloadusr": (1, 1),
     "save": (0, 2), "status": (0, 1), "help": (0, 1), "debug": (1, 1),
-    "print": (0, None), "setexact_for_test_suite_only": (0, 0),
+    "print": (0, 1), "setexact_for_test_suite_only": (0, 0),
 }
 # longest name the reference HAL accepts (its HAL_NAME_LEN)
 REFERENCE_NAME_LEN = 47
@@ -159,6 +159,7 @@ class Executor:
         self.lineno = 0
         self.errors = 0
         self.comp_id: Optional[int] = None
+        self._linkpp_warned = False     # linkpp warns once per process
         self.children: list[subprocess.Popen] = []
         if register:
             self.register()
@@ -354,10 +355,21 @@ class Executor:
             raise CommandError(f"unloadrt failed: {exc}") from None
 
     def cmd_unload(self, args: list[str]) -> None:
+        registered = self.comp_id is not None
+        if args[0] != "all" and _core.find("component", args[0]) is None:
+            raise CommandError(f"component '{args[0]}' is not loaded")
         try:
             self.hal.unload(args[0])
         except HalError as exc:
             raise CommandError(f"unload failed: {exc}") from None
+        finally:
+            # halcmd's own component survives "unload all", as in the
+            # reference
+            if registered and args[0] == "all" and (
+                    self.comp_id is None
+                    or _core.comp_by_id(self.comp_id) is None):
+                self.comp_id = None
+                self.register()
 
     def _rt_modules(self) -> set[str]:
         return {c.name for c in _core.items("component")
@@ -429,9 +441,11 @@ class Executor:
     def cmd_waitusr(self, args: list[str]) -> None:
         name = args[0]
         comp = _core.find("component", name)
-        if comp is None or comp.realtime:
-            raise CommandError(f"component '{name}' not found or not a "
-                               "userspace component")
+        if comp is None:
+            return              # nothing to wait for, as in the reference
+        if comp.realtime:
+            raise CommandError(f"component '{name}' is not a userspace "
+                               "component")
         while comp.exists and comp.alive:
             time.sleep(0.01)
 
@@ -442,9 +456,11 @@ class Executor:
                      if not c.realtime and c.id != self.comp_id]
         else:
             comp = _core.find("component", name)
-            if comp is None or comp.realtime:
-                raise CommandError(f"component '{name}' not found or not "
-                                   "a userspace component")
+            if comp is None:
+                return          # the reference says nothing either
+            if comp.realtime:
+                raise CommandError(f"component '{name}' is not a userspace "
+                                   "component")
             names = [name]
         for comp_name in names:
             try:
@@ -570,13 +586,19 @@ class Executor:
         self._link(args[1], args[0], "link")
 
     def cmd_linkpp(self, args: list[str]) -> None:
-        self.error("Warning: linkpp command is deprecated, use 'net'")
+        if not self._linkpp_warned:         # once, as the reference does
+            self._linkpp_warned = True
+            self.error("Warning: linkpp command is deprecated, use 'net'")
         first, second = args
         pin = find("pin", first)
         if pin is None:
-            raise hal_error(f"pin '{first}' not found", "linkpp failed")
-        if find("pin", second) is None:
-            raise hal_error(f"pin '{second}' not found", "linkpp failed")
+            raise CommandError(f"pin '{first}' not found")
+        other = find("pin", second)
+        if other is None:
+            raise CommandError(f"pin '{second}' not found")
+        if other.type != pin.type:
+            raise CommandError(f"pins '{first}' and '{second}' not of the "
+                               "same type")
         if _core.find("signal", first) is None:
             _core.signal_new(first, pin.type)
             self.created("signal", [first])
@@ -674,8 +696,16 @@ class Executor:
                             "locked", "addf failed")
         if _core.find("function", funct) is None:
             raise hal_error(f"function '{funct}' not found", "addf failed")
-        if _core.find("thread", thread) is None:
+        handle = _core.find("thread", thread)
+        if handle is None:
             raise hal_error(f"thread '{thread}' not found", "addf failed")
+        n = len(handle.functions)
+        if position > n + 1:
+            raise hal_error(f"position '{position}' is too high",
+                            "addf failed")
+        if position < -(n + 1):
+            raise hal_error(f"position '{position}' is too low",
+                            "addf failed")
         try:
             self.hal.addf(funct, thread, position)
         except HalError as exc:
@@ -683,6 +713,8 @@ class Executor:
         self.info(f"Function '{funct}' added to thread '{thread}'")
 
     def cmd_delf(self, args: list[str]) -> None:
+        if not args:
+            raise hal_error("missing function name", "delf failed")
         if len(args) < 2:
             raise hal_error("missing thread name", "delf failed")
         funct, thread = args
@@ -724,6 +756,9 @@ class Executor:
         item = find(kind, name)
         if item is None:
             raise hal_error(f"{kind} '{name}' not found", "alias failed")
+        if find("pin", alias) is not None or find("param", alias) is not None:
+            raise hal_error(f"duplicate pin/alias name '{alias}'",
+                            "alias failed")
         try:
             _core.alias(kind, item.name, alias)
         except HalError as exc:
@@ -734,7 +769,7 @@ class Executor:
     def cmd_unalias(self, args: list[str]) -> None:
         kind, alias = args
         if kind not in ("pin", "param"):
-            raise CommandError("unalias failed")
+            return              # the reference ignores other kinds
         item = _core.find(kind, alias)
         if item is None or item.alias_of is None:
             raise hal_error(f"{kind} '{alias}' not found", "unalias failed")
