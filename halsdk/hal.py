@@ -592,6 +592,38 @@ class Hal:
 
     _captures = 0
 
+    # ------------------------------------------------------------ halcmd
+
+    def source(self, path: str, *, keep_going: bool = False,
+               ini: Optional[str] = None) -> str:
+        """Run a HAL file, as ``halcmd -f`` does; returns what it printed.
+
+        A failing command raises :class:`~halsdk.errors.HalError` with the
+        ``file:line: message`` lines (with ``keep_going``, after running
+        the rest of the file).
+        """
+        from halsdk import halcmd
+        out: list[str] = []
+        err: list[str] = []
+        failures = halcmd.source(self, path, keep_going=keep_going, ini=ini,
+                                 out=out.append, err=err.append)
+        if failures:
+            from halsdk.errors import HalError
+            raise HalError("".join(err).rstrip("\n"))
+        return "".join(out)
+
+    def command(self, line: str) -> str:
+        """Run one line of the HAL language (``"show pin"``, ``"net x a
+        b"``); returns what it printed, raises
+        :class:`~halsdk.errors.HalError` with its message on failure."""
+        from halsdk import halcmd
+        out: list[str] = []
+        err: list[str] = []
+        if not halcmd.command(self, line, out=out.append, err=err.append):
+            from halsdk.errors import HalError
+            raise HalError("".join(err).rstrip("\n") or f"'{line}' failed")
+        return "".join(out)
+
     def check(self) -> None:
         """Verify the instance's invariants; raise if any is broken."""
         bad, report = _core.check_consistency()

@@ -153,3 +153,24 @@ def test_half_made_segment_is_waited_for_and_cleaned_only_when_old():
 
 def n_removed(names: list) -> int:
     return len(names)
+
+
+def test_source_and_command_run_the_hal_language(hal, tmp_path):
+    path = tmp_path / "machine.hal"
+    path.write_text("loadrt and2 count=2\n"
+                    "net chain and2.0.out and2.1.in0\n"
+                    "setp and2.0.in0 1\n"
+                    "getp and2.0.in0\n")
+    assert hal.source(str(path)) == "TRUE\n"
+    assert hal.signal("chain").writers == 1
+    assert "==> and2.1.in0" in hal.command("show sig chain")
+    with pytest.raises(halsdk.HalError, match="nosuch.pin"):
+        hal.command("net x nosuch.pin")
+    bad = tmp_path / "bad.hal"
+    bad.write_text("setp and2.0.in1 1\nsetp nothing 1\nsetp and2.1.in1 1\n")
+    with pytest.raises(halsdk.HalError, match=r"bad.hal:2: "):
+        hal.source(str(bad))
+    assert hal.getp("and2.0.in1") is True and hal.getp("and2.1.in1") is False
+    with pytest.raises(halsdk.HalError, match=r"bad.hal:2: "):
+        hal.source(str(bad), keep_going=True)
+    assert hal.getp("and2.1.in1") is True
