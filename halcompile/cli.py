@@ -10,6 +10,11 @@ Modes (one per run; ``--preprocess`` is the default):
 ``--install``     build into the user component folder, where ``loadrt``
                   finds it with no set-up
 
+A ``.comp`` with ``option userspace`` (or a ``.c`` program with ``-u``)
+also gets an executable launcher for ``loadusr`` (see
+:mod:`halcompile.gen_user`); one with ``option cython`` is built from a
+generated ``.pyx`` (see :mod:`halcompile.gen_cython`).
+
 User errors print ``file:line:col: message`` (or the compiler's messages,
 which point into the ``.comp`` file) and exit with status 1.
 """
@@ -55,7 +60,9 @@ def _arg_parser() -> argparse.ArgumentParser:
                         "folder that receives the module (one input only "
                         "for --preprocess)")
     p.add_argument("-u", "--userspace", action="store_true",
-                   help="build userspace components (not supported yet)")
+                   help="a .c input is a userspace program (with main()), "
+                        "started by loadusr; .comp files say it with "
+                        "'option userspace'")
     p.add_argument("--extra-compile-args", default="",
                    help="more C compiler arguments (one string)")
     p.add_argument("--extra-link-args", default="",
@@ -76,8 +83,6 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         if mode in ("document", "view_doc", "install_doc"):
             raise UsageError(f"--{mode.replace('_', '-')} is not supported "
                              "yet")
-        if args.userspace:
-            raise UsageError("--userspace is not supported yet")
         if args.personalities < 1:
             raise UsageError("--personalities must be at least 1")
         if args.output and mode == "preprocess" and len(args.files) > 1:
@@ -85,7 +90,8 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         for path in args.files:
             process(path, mode, args.output,
                     shlex.split(args.extra_compile_args),
-                    shlex.split(args.extra_link_args), args.personalities)
+                    shlex.split(args.extra_link_args), args.personalities,
+                    userspace=args.userspace)
     except (CompError, UsageError) as exc:
         print(f"{exc}" if isinstance(exc, CompError)
               else f"halcompile: {exc}", file=sys.stderr)
@@ -105,9 +111,10 @@ class _Failed(Exception):
 
 def process(path: str, mode: str, output: Optional[str] = None,
             cflags: Sequence[str] = (), ldflags: Sequence[str] = (),
-            personalities: int = MAX_PERSONALITIES) -> str:
+            personalities: int = MAX_PERSONALITIES,
+            userspace: bool = False) -> str:
     """Preprocess, compile or install one file; returns what was
-    written."""
+    written.  ``userspace``: a ``.c`` file is a userspace program."""
     if not os.path.isfile(path):
         raise UsageError(f"{path}: no such file")
     ext = os.path.splitext(path)[1]
@@ -115,10 +122,13 @@ def process(path: str, mode: str, output: Optional[str] = None,
         if mode == "preprocess":
             raise UsageError(f"{path}: a .c file needs --compile or "
                              "--install")
-        return _build(path, None, mode, output, cflags, ldflags)
+        return _build(path, None, mode, output, cflags, ldflags,
+                      userspace=userspace)
     if ext != ".comp":
         raise UsageError(f"{path}: expected a .comp or .c file")
     comp = parse_file(path)
+    if comp.option("cython"):
+        return _cython(path, comp, mode, output, cflags, ldflags)
     if mode == "preprocess":
         out = output or os.path.splitext(path)[0] + ".c"
         text = generate(comp, os.path.basename(out), personalities)
@@ -131,7 +141,8 @@ def process(path: str, mode: str, output: Optional[str] = None,
 def _build(path: str, comp: Optional[Component], mode: str,
            output: Optional[str], cflags: Sequence[str],
            ldflags: Sequence[str],
-           personalities: int = MAX_PERSONALITIES) -> str:
+           personalities: int = MAX_PERSONALITIES,
+           userspace: bool = False) -> str:
     from halsdk.build import BuildError, build_component
     from halsdk.loader import user_component_dir
 
@@ -140,7 +151,11 @@ def _build(path: str, comp: Optional[Component], mode: str,
     includes = [os.path.dirname(os.path.abspath(path))]
     flags = _PRIVATE + list(cflags)
     try:
-        if comp is None:
+        if comp is None and userspace:
+            name = os.path.splitext(os.path.basename(path))[0]
+            dest = _build_program(path, name, out_dir, includes, flags,
+                                  list(ldflags))
+        elif comp is None:
             name = os.path.splitext(os.path.basename(path))[0]
             dest = build_component(path, out_dir=out_dir, name=name,
                                    include_dirs=includes,
@@ -168,8 +183,108 @@ def _build(path: str, comp: Optional[Component], mode: str,
         body = "\n".join(ln for ln in lines[1:] if not _NOISE.search(ln)) \
             if len(lines) > 1 else str(exc)
         raise _Failed(f"{path}: compilation failed:\n{body}") from None
+    if userspace or (comp is not None and comp.option("userspace")):
+        dest = _launchers(dest, mode)
     print(dest)
     return dest
+
+
+def _cython(path: str, comp: Component, mode: str, output: Optional[str],
+            cflags: Sequence[str], ldflags: Sequence[str]) -> str:
+    """A .comp whose code section is Cython: write its .pyx
+    (--preprocess) or build it."""
+    from halcompile import gen_cython
+    from halcompile.model import Loc
+    from halsdk.build import BuildError, build_component
+    from halsdk.loader import user_component_dir
+
+    try:
+        text, origin = gen_cython.generate(comp)
+    except gen_cython.CythonSourceError as exc:
+        with open(path, encoding="utf-8") as f:
+            lines = f.read().split("\n")
+        shown = lines[exc.line - 1] if 0 < exc.line <= len(lines) else None
+        raise CompError(Loc(comp.file, exc.line, 1), exc.message,
+                        shown) from None
+    if mode == "preprocess":
+        out = output or os.path.splitext(path)[0] + ".pyx"
+        with open(out, "w", encoding="utf-8") as f:
+            f.write(text)
+        return out
+    out_dir = user_component_dir() if mode == "install" else \
+        (output or os.getcwd())
+    flags = _PRIVATE + list(cflags) + shlex.split(
+        str(comp.option("extra_compile_args", "")))
+    ldflags = list(ldflags) + shlex.split(
+        str(comp.option("extra_link_args", "")))
+    with tempfile.TemporaryDirectory(prefix="halcompile-") as tmp:
+        pyx = os.path.join(tmp, comp.name + ".pyx")
+        with open(pyx, "w", encoding="utf-8") as f:
+            f.write(text)
+        try:
+            dest = build_component(
+                pyx, out_dir=out_dir, name=comp.name,
+                include_dirs=[os.path.dirname(os.path.abspath(path))],
+                extra_compile_args=flags, extra_link_args=ldflags)
+        except BuildError as exc:
+            raise _Failed(f"{path}: compilation failed:\n"
+                          + _map_pyx_lines(str(exc), comp, origin)) from None
+    print(dest)
+    return dest
+
+
+def _map_pyx_lines(message: str, comp: Component,
+                   origin: list[tuple[int, int]]) -> str:
+    """Point Cython's ``x.pyx:LINE:COL:`` messages at the .comp line (and
+    column) the text came from; generated lines keep the .pyx place."""
+    out = []
+    for line in message.splitlines()[1:] or message.splitlines():
+        if _NOISE.search(line) or line.startswith("Error compiling Cython"):
+            continue
+
+        def repl(m: re.Match[str]) -> str:
+            n, col = int(m.group(2)), int(m.group(3))
+            src, shift = origin[n - 1] if 0 < n <= len(origin) else (0, 0)
+            if not src:
+                return f"{comp.name}.pyx (generated):{n}:{col}"
+            # Cython counts columns from 0
+            return f"{comp.file}:{src}:{max(1, col - shift + 1)}"
+        out.append(re.sub(r"(\S*\.pyx):(\d+):(\d+)", repl, line))
+    return "\n".join(out)
+
+
+def _build_program(path: str, name: str, out_dir: str,
+                   includes: list[str], flags: list[str],
+                   ldflags: list[str]) -> str:
+    """Build a hand-written userspace program (``main()``) into a
+    component module (see :mod:`halcompile.gen_user`)."""
+    from halcompile.gen_user import program_wrapper
+    from halsdk.build import build_component
+
+    with tempfile.TemporaryDirectory(prefix="halcompile-") as tmp:
+        wrapper = os.path.join(tmp, "halsdk_user_main.c")
+        with open(wrapper, "w", encoding="utf-8") as f:
+            f.write(program_wrapper())
+        # the program's main() becomes a plain function of the module
+        return build_component(path, out_dir=out_dir, name=name,
+                               extra_sources=[wrapper],
+                               include_dirs=includes,
+                               extra_compile_args=flags
+                               + ["-Dmain=halsdk_user_main"],
+                               extra_link_args=ldflags)
+
+
+def _launchers(module: str, mode: str) -> str:
+    """Write the launcher script of a userspace module next to it (and,
+    for --install, into the user's bin folder); returns the script
+    next to the module."""
+    from halcompile.gen_user import user_bin_dir, write_launcher
+
+    name = os.path.basename(module).split(".")[0]
+    script = write_launcher(os.path.dirname(module), name, module)
+    if mode == "install":
+        print(write_launcher(user_bin_dir(), name, module))
+    return script
 
 
 def _local_headers_digest(comp: Component, folder: str) -> str:

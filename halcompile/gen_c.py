@@ -106,6 +106,8 @@ def generate(comp: Component, c_filename: str = "",
           '#include "rtapi_math.h"', '#include "rtapi_ctype.h"',
           '#include "hal.h"', "#include <stdint.h>", "#include <limits.h>",
           "#include <float.h>")
+    if comp.option("userspace"):
+        w.add("#include <stdlib.h>")
     for inc, loc in zip(comp.includes, comp.include_locs):
         # "#include" is 8 characters: the header name lands on its column
         w.expr(Loc(loc.file, loc.line, max(1, loc.col - 8)), "#include" + inc)
@@ -212,7 +214,10 @@ def generate(comp: Component, c_filename: str = "",
           "        __comp_first_inst = inst;",
           "    return 0;", "}", "")
 
-    if comp.option("rtapi_app", True):
+    if comp.option("userspace"):
+        from halcompile.gen_user import app_main
+        app_main(w, comp)
+    elif comp.option("rtapi_app", True):
         _app_main(w, comp, personality, singleton, count_function,
                   max_personalities)
 

@@ -26,7 +26,7 @@ OPTIONS = {
     "extra_compile_args": "str", "extra_link_args": "str",
     "homemod": "bool", "tpmod": "bool", "constructable": "bool",
     "fp": "bool", "period": "bool", "no_convenience_defines": "bool",
-    "default_personality": "int",
+    "default_personality": "int", "cython": "bool",
 }
 
 #: names the generated code uses for itself

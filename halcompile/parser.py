@@ -509,8 +509,30 @@ def check(comp: Component, parser: _Parser) -> None:
             raise _err(parser, f.loc, f"two functions named '{f.hal_name}'")
         fnames.add(f.hal_name)
     if comp.option("userspace"):
-        raise _err(parser, comp.option_locs["userspace"],
-                   "userspace components are not supported yet")
+        if comp.functions:
+            raise _err(parser, comp.option_locs["userspace"],
+                       "userspace components may not have functions "
+                       f"(remove 'function {comp.functions[0].name}')")
+        if not re.search(r"\buser_mainloop\b", comp.code):
+            raise _err(parser, comp.option_locs["userspace"],
+                       "option userspace needs 'void user_mainloop(void)' "
+                       "in the code section")
+        if comp.option("userinit") and not re.search(r"\buserinit\b",
+                                                     comp.code):
+            raise _err(parser, comp.option_locs["userinit"],
+                       "option userinit needs 'void userinit(int argc, "
+                       "char **argv)' in the code section")
+    elif comp.option("userinit"):
+        # the reference warns and goes on
+        comp.options["userinit"] = False
+    if comp.option("cython"):
+        for opt, bad in (("data", None), ("rtapi_app", False),
+                         ("userspace", True)):
+            if opt in comp.options and (bad is None
+                                        or comp.options[opt] == bad):
+                raise _err(parser, comp.option_locs[opt],
+                           f"option {opt} is not supported with option "
+                           "cython")
     if comp.option("singleton") and comp.option("count_function"):
         raise _err(parser, comp.option_locs["count_function"],
                    "option count_function cannot go with option singleton")

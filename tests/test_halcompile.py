@@ -542,7 +542,7 @@ PIN = "pin in bit the_pin;\n"
     ("function _;\n", "x.comp:4:10", "duplicate item name '_'"),
     ("modparam float f;\n", "x.comp:4:10", "expected a modparam type"),
     ("/* open comment\n", "x.comp:4:1", "unterminated comment"),
-    ("option userspace yes;\n", "x.comp:4:8", "not supported yet"),
+    ("option userspace yes;\n", "x.comp:4:8", "may not have functions"),
     ("option singleton;\noption count_function;\n", "x.comp:5:8",
      "cannot go with option singleton"),
     ("pin out bit a if ;\n", "x.comp:4:18", "expected a condition"),
