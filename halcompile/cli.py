@@ -9,6 +9,14 @@ Modes (one per run; ``--preprocess`` is the default):
                   ``-o DIR``); ``loadrt`` finds it through ``HALSDK_PATH``
 ``--install``     build into the user component folder, where ``loadrt``
                   finds it with no set-up
+``--document``    write the manual page (``NAME.9``; ``NAME.1`` for a
+                  userspace component) and the reStructuredText page
+                  (``NAME.rst``) of each ``.comp`` into the current folder
+                  (or the folder ``-o DIR``)
+``--view-doc``    show the manual page of each ``.comp`` (with ``man``)
+``--install-doc`` install the manual page of each ``.comp`` into the
+                  user's manual folder (``~/.local/share/man``, or the
+                  folder ``-o DIR``), where ``man`` finds it
 
 A ``.comp`` with ``option userspace`` (or a ``.c`` program with ``-u``)
 also gets an executable launcher for ``loadusr`` (see
@@ -56,9 +64,10 @@ def _arg_parser() -> argparse.ArgumentParser:
         mode.add_argument(f"--{flag}", dest="mode", action="store_const",
                           const=flag.replace("-", "_"))
     p.add_argument("-o", "--of", dest="output", metavar="OUT",
-                   help="--preprocess: the C file to write; --compile: the "
-                        "folder that receives the module (one input only "
-                        "for --preprocess)")
+                   help="--preprocess: the C file to write; --compile and "
+                        "--document: the folder that receives the module or "
+                        "the pages; --install-doc: the manual folder (one "
+                        "input only for --preprocess)")
     p.add_argument("-u", "--userspace", action="store_true",
                    help="a .c input is a userspace program (with main()), "
                         "started by loadusr; .comp files say it with "
@@ -81,8 +90,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     mode = args.mode or "preprocess"
     try:
         if mode in ("document", "view_doc", "install_doc"):
-            raise UsageError(f"--{mode.replace('_', '-')} is not supported "
-                             "yet")
+            return _document(mode, args.files, args.output)
         if args.personalities < 1:
             raise UsageError("--personalities must be at least 1")
         if args.output and mode == "preprocess" and len(args.files) > 1:
@@ -107,6 +115,30 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
 
 class _Failed(Exception):
     """A build failed; the message is what the user needs to see."""
+
+
+def _document(mode: str, files: Sequence[str],
+              output: Optional[str]) -> int:
+    """--document, --view-doc and --install-doc: the pages of each
+    ``.comp`` (raises :class:`UsageError` or
+    :class:`~halcompile.parser.CompError` for bad input)."""
+    from halcompile.gen_doc import document, install_doc, view_doc
+
+    for path in files:
+        if not os.path.isfile(path):
+            raise UsageError(f"{path}: no such file")
+        if not path.endswith(".comp"):
+            raise UsageError(f"{path}: only .comp files have documentation")
+    status = 0
+    for path in files:
+        if mode == "document":
+            for written in document(path, output or os.getcwd()):
+                print(written)
+        elif mode == "install_doc":
+            print(install_doc(path, output))
+        else:
+            status = view_doc(path) or status
+    return status
 
 
 def process(path: str, mode: str, output: Optional[str] = None,

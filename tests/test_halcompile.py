@@ -504,7 +504,9 @@ def test_missing_file_and_bad_mode(tmp_path):
     proc = halcompile("--compile", "nothere.comp", cwd=str(tmp_path))
     assert proc.returncode == 1
     assert proc.stderr.strip() == "halcompile: nothere.comp: no such file"
-    assert main(["--document", os.path.join(COMPS, "hcddt.comp")]) == 1
+    assert main(["--document", "-o", str(tmp_path / "doc"),
+                 os.path.join(COMPS, "hcddt.comp")]) == 0
+    assert sorted(os.listdir(tmp_path / "doc")) == ["hcddt.9", "hcddt.rst"]
 
 
 # ------------------------------------------------------------ the language
