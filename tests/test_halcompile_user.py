@@ -204,6 +204,25 @@ def test_loadusr_from_halrun_file(progs, tmp_path):
     assert len(comps) == 1 and comps[0].startswith("halcmd")
 
 
+def test_loadusr_finds_launchers_on_halsdk_path(progs, tmp_path):
+    """A compiled userspace component in a HALSDK_PATH folder starts by
+    name, with no PATH set-up."""
+    hal_file = tmp_path / "user.hal"
+    hal_file.write_text("loadusr -W hcuser scale=2 names=beta\n"
+                        "setp beta.in 1.5\n"
+                        "loadusr -w sleep 0.3\n"
+                        "getp beta.out\n"
+                        "unload hcuser\n")
+    env = _env(HALSDK_PATH=progs, HALSDK_INSTANCE=f"hcpath{os.getpid()}")
+    assert progs not in env["PATH"].split(os.pathsep)
+    proc = subprocess.run([sys.executable, "-m", "halsdk.halcmd.cli",
+                           "halrun", "-f", str(hal_file)], cwd=str(tmp_path),
+                          env=env, capture_output=True, text=True,
+                          timeout=60)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.splitlines()[0] == "3.5"      # 1.5 * 2 + offset
+
+
 def test_userspace_program_exit_status(hal, progs):
     proc = subprocess.run([os.path.join(progs, "hcprog"), "fail"],
                           cwd=progs, env=_env(), capture_output=True,

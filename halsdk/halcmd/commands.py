@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import os
 import re
+import shutil
 import subprocess
 import sys
 import time
@@ -87,6 +88,19 @@ def find(kind: str, name: str):
     """A pin, param or signal by name (pins and params also by the name
     they had before an alias: the core looks those up too)."""
     return _core.find(kind, name)
+
+
+def _program_path(prog: str) -> str:
+    """A program for loadusr: on PATH, else a launcher that halcompile
+    put in a HALSDK_PATH folder or the user component folder."""
+    if os.sep in prog or shutil.which(prog) is not None:
+        return prog
+    from halsdk.loader import search_path
+    for folder in search_path():
+        path = os.path.join(folder, prog)
+        if os.path.isfile(path) and os.access(path, os.X_OK):
+            return path
+    return prog
 
 
 class Quit(Exception):
@@ -414,7 +428,8 @@ class Executor:
             raise CommandError("HAL is locked, loading of programs is not "
                                "permitted")
         try:
-            child = subprocess.Popen(args, stdin=subprocess.DEVNULL)
+            child = subprocess.Popen([_program_path(prog), *args[1:]],
+                                     stdin=subprocess.DEVNULL)
         except OSError as exc:
             raise CommandError(f"execv({prog}): {exc.strerror}",
                                f"program '{prog}' failed, returned 1"
