@@ -11,6 +11,8 @@
 
 from halsdk cimport hal
 
+from halsdk.components._channels import MODPARAMS, channels
+
 hal.import_halsdk()
 
 cdef struct channel_t:
@@ -59,13 +61,7 @@ cdef void sample(void *arg, long period) noexcept nogil:
         c.curr_depth[0] = hal.halsdk_stream_depth(c.stream)
 
 
-_LETTERS = {"f": hal.HAL_FLOAT, "b": hal.HAL_BIT, "s": hal.HAL_S32,
-            "u": hal.HAL_U32, "l": hal.HAL_S64, "k": hal.HAL_U64}
-
-modparams = {
-    "depth": ([int], None, "FIFO depth (records) of each channel"),
-    "cfg": ([str], None, "pin types of each channel: letters f b s u l k"),
-}
+modparams = dict(MODPARAMS)
 
 cdef int comp_id = -1
 
@@ -79,42 +75,22 @@ def setup(depth=None, cfg=None):
     global comp_id
     cdef channel_t *c
     cdef int i, m, r
-    cfgs = [s for s in (cfg or []) if s != ""]
-    depths = list(depth or [])
-    if not cfgs:
-        raise ValueError("sampler: no channels specified (give "
-                         "cfg=STRING[,STRING...])")
-    for i, s in enumerate(cfgs):
-        if i >= len(depths):
-            raise ValueError(f"sampler.{i}: no depth given for cfg '{s}' "
-                             "(give depth=D1[,D2...], one per cfg string)")
-        if depths[i] < 1:
-            raise ValueError(f"sampler.{i}: depth {depths[i]} is not a "
-                             "positive number of samples")
-        if len(s) > 256:
-            raise ValueError(f"sampler.{i}: cfg string has {len(s)} "
-                             "letters; at most 256")
-        for ch in s:
-            if ch.lower() not in _LETTERS:
-                raise ValueError(
-                    f"sampler.{i}: unknown type '{ch}' in cfg string "
-                    f"'{s}' (letters: f float, b bit, s s32, u u32, "
-                    "l s64, k u64)")
+    chans = channels("sampler", depth, cfg)
     comp_id = hal.hal_init(b"sampler")
     if comp_id < 0:
         _fail("sampler: hal_init failed")
-    for i, s in enumerate(cfgs):
+    for i, (s, types, d) in enumerate(chans):
         c = <channel_t *>hal.hal_malloc(sizeof(channel_t))
         if c == NULL:
             raise MemoryError(f"sampler.{i}: hal_malloc failed")
         c.n = len(s)
-        c.maxdepth = depths[i]
+        c.maxdepth = d
         c.stream = hal.halsdk_stream_create(f"sampler.{i}".encode(), comp_id,
-                                            depths[i], s.encode())
+                                            d, s.encode())
         if c.stream < 0:
             _fail(f"sampler.{i}")
-        for m, ch in enumerate(s):
-            c.types[m] = _LETTERS[ch.lower()]
+        for m in range(len(types)):
+            c.types[m] = types[m]
             name = f"sampler.{i}.pin.{m}".encode()
             if hal.hal_pin_new(name, <hal.hal_type_t>c.types[m], hal.HAL_IN,
                                &c.pins[m], comp_id) < 0:

@@ -13,6 +13,8 @@
 
 from halsdk cimport hal
 
+from halsdk.components._channels import MODPARAMS, channels
+
 hal.import_halsdk()
 
 cdef struct channel_t:
@@ -73,13 +75,7 @@ cdef void play(void *arg, long period) noexcept nogil:
             (<hal.hal_u64_t *>p)[0] = c.rec[i].lu
 
 
-_LETTERS = {"f": hal.HAL_FLOAT, "b": hal.HAL_BIT, "s": hal.HAL_S32,
-            "u": hal.HAL_U32, "l": hal.HAL_S64, "k": hal.HAL_U64}
-
-modparams = {
-    "depth": ([int], None, "FIFO depth (records) of each channel"),
-    "cfg": ([str], None, "pin types of each channel: letters f b s u l k"),
-}
+modparams = dict(MODPARAMS)
 
 cdef int comp_id = -1
 
@@ -93,41 +89,21 @@ def setup(depth=None, cfg=None):
     global comp_id
     cdef channel_t *c
     cdef int i, m, r
-    cfgs = [s for s in (cfg or []) if s != ""]
-    depths = list(depth or [])
-    if not cfgs:
-        raise ValueError("streamer: no channels specified (give "
-                         "cfg=STRING[,STRING...])")
-    for i, s in enumerate(cfgs):
-        if i >= len(depths):
-            raise ValueError(f"streamer.{i}: no depth given for cfg '{s}' "
-                             "(give depth=D1[,D2...], one per cfg string)")
-        if depths[i] < 1:
-            raise ValueError(f"streamer.{i}: depth {depths[i]} is not a "
-                             "positive number of samples")
-        if len(s) > 256:
-            raise ValueError(f"streamer.{i}: cfg string has {len(s)} "
-                             "letters; at most 256")
-        for ch in s:
-            if ch.lower() not in _LETTERS:
-                raise ValueError(
-                    f"streamer.{i}: unknown type '{ch}' in cfg string "
-                    f"'{s}' (letters: f float, b bit, s s32, u u32, "
-                    "l s64, k u64)")
+    chans = channels("streamer", depth, cfg)
     comp_id = hal.hal_init(b"streamer")
     if comp_id < 0:
         _fail("streamer: hal_init failed")
-    for i, s in enumerate(cfgs):
+    for i, (s, types, d) in enumerate(chans):
         c = <channel_t *>hal.hal_malloc(sizeof(channel_t))
         if c == NULL:
             raise MemoryError(f"streamer.{i}: hal_malloc failed")
         c.n = len(s)
         c.stream = hal.halsdk_stream_create(f"streamer.{i}".encode(),
-                                            comp_id, depths[i], s.encode())
+                                            comp_id, d, s.encode())
         if c.stream < 0:
             _fail(f"streamer.{i}")
-        for m, ch in enumerate(s):
-            c.types[m] = _LETTERS[ch.lower()]
+        for m in range(len(types)):
+            c.types[m] = types[m]
             name = f"streamer.{i}.pin.{m}".encode()
             if hal.hal_pin_new(name, <hal.hal_type_t>c.types[m], hal.HAL_OUT,
                                &c.pins[m], comp_id) < 0:
