@@ -48,11 +48,12 @@ from __future__ import annotations
 
 import math
 import os
-import signal
 import sys
 import time
 from collections.abc import Sequence
 from typing import Any, NamedTuple, Optional
+
+from halsdk.tools._attach import attach, stop_on_signals
 
 PROG = "halmeter"
 DEFAULT_PERIOD_MS = 100.0
@@ -206,21 +207,11 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
               "pin/signal/parameter name", file=sys.stderr)
         return 1
 
-    stop: list = []
-
-    def on_signal(signum, frame):  # noqa: ARG001
-        stop.append(signum)
-
-    for sig in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(sig, on_signal)
+    stop = stop_on_signals()
 
     from halsdk import errors
-    from halsdk.hal import Hal
-    try:
-        hal = Hal(create=False)
-    except errors.HalError as e:
-        print(f"{PROG}: ERROR: cannot attach to the HAL instance: {e}",
-              file=sys.stderr)
+    hal = attach(PROG)
+    if hal is None:
         return 1
     what = _KINDS[opts.kind]
     try:

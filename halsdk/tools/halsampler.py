@@ -15,11 +15,12 @@ with status 1.
 from __future__ import annotations
 
 import math
-import signal
 import sys
 import time
 from collections.abc import Sequence
 from typing import IO, Optional
+
+from halsdk.tools._attach import attach, stop_on_signals
 
 PROG = "halsampler"
 POLL_S = 0.01
@@ -124,21 +125,11 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     except _Usage as e:
         print(e, file=sys.stderr)
         return 1
-    stop: list = []
-
-    def on_signal(signum, frame):  # noqa: ARG001
-        stop.append(signum)
-
-    for sig in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(sig, on_signal)
+    stop = stop_on_signals()
 
     from halsdk import _core, errors
-    from halsdk.hal import Hal
-    try:
-        hal = Hal(create=False)
-    except errors.HalError as e:
-        print(f"{PROG}: ERROR: cannot attach to the HAL instance: {e}",
-              file=sys.stderr)
+    hal = attach(PROG)
+    if hal is None:
         return 1
     name = f"sampler.{chan}"
     out: IO[str]
