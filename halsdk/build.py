@@ -3,23 +3,35 @@
 :func:`build_component` compiles a component source into an extension
 module that ``loadrt`` can load, with the system C compiler.  Results are
 cached by a hash of everything that goes into the build (sources, halsdk
-headers, Python version, flags), so a second build of the same source is
-a file copy.
+headers, Python version, compiler and flags), so a second build of the
+same source is a file copy.
+
+There is no setuptools round-trip: Cython runs in this process, then the
+compiler (one process per C file, in parallel) and the linker are called
+directly, with the commands setuptools would use: ``CC CFLAGS CCSHARED``
+and ``LDSHARED`` of :mod:`sysconfig` (and the same environment variables,
+see :func:`toolchain`), the Python include folders and ``EXT_SUFFIX``.
+A finished module is moved into the cache in one rename, so a failed or
+interrupted build leaves nothing there.
 
 Cache folder: ``$HALSDK_CACHE`` or ``~/.cache/halsdk/build``.
 """
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import importlib.machinery
+import io
 import os
 import re
+import shlex
 import shutil
 import subprocess
 import sys
 import sysconfig
 import tempfile
+import threading
 from collections.abc import Sequence
 from typing import Optional
 
@@ -33,6 +45,8 @@ _DIAG = re.compile(r"^\S[^:]*:\d+:(\d+:)? |^In file included|^\s+\d* *\||"
                    r"[Ee]rror")
 _NOISE = re.compile(r"^\s*raise |^(distutils|setuptools)\.|Error: command|"
                     r"^Traceback|^\s+File ")
+#: Cython keeps its error state per thread but redirects sys.stderr
+_CYTHON_LOCK = threading.Lock()
 _FLAGS = ["-O2", "-std=gnu11", "-Wall", "-Wno-unused-function",
           "-Wno-unused-variable"]
 
@@ -53,7 +67,8 @@ def cache_dir() -> str:
 
 
 def extension_suffix() -> str:
-    return importlib.machinery.EXTENSION_SUFFIXES[0]
+    return sysconfig.get_config_var("EXT_SUFFIX") or \
+        importlib.machinery.EXTENSION_SUFFIXES[0]
 
 
 def _digest(paths: Sequence[str], extra: Sequence[str],
@@ -82,27 +97,40 @@ def _digest(paths: Sequence[str], extra: Sequence[str],
     return h.hexdigest()[:24]
 
 
-_BUILD_SCRIPT = r"""
-import json, sys
-from setuptools import Distribution, Extension
-spec = json.loads(sys.argv[1])
-exts = [Extension(spec["name"], sources=spec["sources"],
-                  include_dirs=spec["include_dirs"],
-                  extra_compile_args=spec["cflags"],
-                  extra_link_args=spec["ldflags"],
-                  define_macros=[tuple(d) for d in spec["macros"]])]
-if spec["cython"]:
-    from Cython.Build import cythonize
-    exts = cythonize(exts, include_path=spec["pxd_path"], quiet=True,
-                     build_dir=spec["tmp"], language_level=3,
-                     compiler_directives={"boundscheck": False,
-                                          "wraparound": False})
-dist = Distribution({"ext_modules": exts, "script_name": "build",
-                     "script_args": ["build_ext", "--build-lib", spec["lib"],
-                                     "--build-temp", spec["tmp"]]})
-dist.parse_command_line()
-dist.run_commands()
-"""
+def toolchain() -> tuple[list[str], list[str]]:
+    """The C compiler and shared-library linker commands, as setuptools
+    builds them from sysconfig (``CC CFLAGS CCSHARED`` and ``LDSHARED``)
+    and the ``CC``/``CFLAGS``/``CPPFLAGS``/``LDSHARED``/``LDFLAGS``
+    environment variables."""
+    cc, cflags, ccshared, ldshared = (
+        sysconfig.get_config_var(v) or ""
+        for v in ("CC", "CFLAGS", "CCSHARED", "LDSHARED"))
+    env = os.environ
+    if "CC" in env:
+        if "LDSHARED" not in env and ldshared.startswith(cc):
+            ldshared = env["CC"] + ldshared[len(cc):]
+        cc = env["CC"]
+    if "LDSHARED" in env:
+        ldshared = env["LDSHARED"]
+    if "LDFLAGS" in env:
+        ldshared += " " + env["LDFLAGS"]
+    for var in ("CFLAGS", "CPPFLAGS"):
+        if var in env:
+            cflags += " " + env[var]
+            ldshared += " " + env[var]
+    return (shlex.split(f"{cc} {cflags} {ccshared}"), shlex.split(ldshared))
+
+
+def _python_includes() -> list[str]:
+    paths = sysconfig.get_paths()
+    return list(dict.fromkeys([paths["include"], paths["platinclude"]]))
+
+
+def _library_dirs() -> list[str]:
+    # setuptools adds it when Python is a shared library
+    libdir = sysconfig.get_config_var("LIBDIR")
+    return [libdir] if sysconfig.get_config_var("Py_ENABLE_SHARED") \
+        and libdir else []
 
 
 def build_component(source: str, out_dir: Optional[str] = None,
@@ -134,14 +162,16 @@ def build_component(source: str, out_dir: Optional[str] = None,
     cython = ext == ".pyx"
     extras = [os.path.abspath(s) for s in extra_sources]
     cflags = _FLAGS + list(extra_compile_args)
+    compiler, linker = toolchain()
     key = _digest([source] + extras,
-                  [name, *cflags, *extra_link_args, *include_dirs],
+                  [name, *cflags, *extra_link_args, *include_dirs, "\1",
+                   *compiler, "\2", *linker],
                   [os.path.dirname(source), *include_dirs])
     target_dir = os.path.join(cache_dir(), key)
     built = os.path.join(target_dir, name + extension_suffix())
     if force or not os.path.isfile(built):
         _compile(source, extras, name, cython, cflags, list(extra_link_args),
-                 list(include_dirs), target_dir)
+                 list(include_dirs), target_dir, compiler, linker)
     if out_dir is None:
         return built
     os.makedirs(out_dir, exist_ok=True)
@@ -154,48 +184,117 @@ def build_component(source: str, out_dir: Optional[str] = None,
 
 def _compile(source: str, extras: list[str], name: str, cython: bool,
              cflags: list[str], ldflags: list[str], includes: list[str],
-             target_dir: str) -> None:
-    import json
-
+             target_dir: str, compiler: list[str],
+             linker: list[str]) -> None:
+    """Build the module into ``target_dir`` (made atomically): Cython (in
+    this process) for a .pyx, then one compiler process per C file (run
+    in parallel) and the linker."""
     os.makedirs(os.path.dirname(target_dir), exist_ok=True)
     with tempfile.TemporaryDirectory(prefix="halsdk-build-") as tmp:
-        work = os.path.join(tmp, "src")
-        os.makedirs(work)
-        macros: list[list[str]] = []
+        macros: list[str] = []
         if cython:
             # the module name comes from the file name
-            src = os.path.join(work, name + ".pyx")
+            src = os.path.join(tmp, name + ".pyx")
             shutil.copy2(source, src)
-            sources = [src] + extras
+            c_file = os.path.join(tmp, name + ".c")
+            _cythonize(source, src, c_file, name)
+            sources = [c_file] + extras
         else:
             sources = [C_ENTRY, source] + extras
             # every file shares the API pointer that the entry defines
-            macros += [["HALSDK_MODULE_NAME", name],
-                       ["HALSDK_API_EXTERN", "1"]]
-        spec = {
-            "name": name, "sources": sources, "cython": cython,
-            "include_dirs": [INCLUDE_DIR, os.path.dirname(source), *includes,
-                             sysconfig.get_paths()["include"]],
-            "cflags": cflags, "ldflags": ldflags, "macros": macros,
-            "pxd_path": [os.path.dirname(PACKAGE_DIR)],
-            "tmp": os.path.join(tmp, "tmp"), "lib": os.path.join(tmp, "lib"),
-        }
-        proc = subprocess.run(
-            [sys.executable, "-c", _BUILD_SCRIPT, json.dumps(spec)],
-            capture_output=True, text=True, cwd=tmp)
-        out = os.path.join(tmp, "lib", name + extension_suffix())
-        if proc.returncode != 0 or not os.path.isfile(out):
-            lines = (proc.stdout + proc.stderr).splitlines()
-            # the compiler's diagnostics with their source lines and
-            # carets; not the build tools' own traceback
-            relevant = [ln for ln in lines if _DIAG.search(ln)
-                        and not _NOISE.search(ln)] or lines
-            raise BuildError(f"{source}: build failed:\n" +
-                             "\n".join(relevant[-40:]))
-        staging = target_dir + f".{os.getpid()}.tmp"
-        os.makedirs(staging, exist_ok=True)
-        shutil.copy2(out, os.path.join(staging, os.path.basename(out)))
+            macros += [f"-DHALSDK_MODULE_NAME={name}",
+                       "-DHALSDK_API_EXTERN=1"]
+        incs = [f"-I{d}" for d in [INCLUDE_DIR, os.path.dirname(source),
+                                   *includes, *_python_includes()]]
+        objects = [os.path.join(tmp, f"{i}-{os.path.basename(src)}.o")
+                   for i, src in enumerate(sources)]
+        results = _run_all([compiler + macros + incs +
+                            ["-c", src, "-o", obj] + cflags
+                            for src, obj in zip(sources, objects)], tmp)
+        failed = [out for rc, out in results if rc != 0]
+        if failed:
+            _fail(source, "\n".join(failed))
+        staging = target_dir + \
+            f".{os.getpid()}.{threading.get_ident()}.tmp"
+        shutil.rmtree(staging, ignore_errors=True)
+        os.makedirs(staging)
         try:
-            os.rename(staging, target_dir)
-        except OSError:
-            shutil.rmtree(staging, ignore_errors=True)   # built by another
+            out = os.path.join(staging, name + extension_suffix())
+            (rc, text), = _run_all(
+                [linker + objects + ["-o", out]
+                 + [f"-L{d}" for d in _library_dirs()] + ldflags], tmp)
+            if rc != 0 or not os.path.isfile(out):
+                _fail(source, text)
+            try:
+                os.rename(staging, target_dir)
+            except OSError:
+                # built meanwhile by another process, or a broken entry
+                if not os.path.isfile(os.path.join(target_dir,
+                                                   os.path.basename(out))):
+                    shutil.rmtree(target_dir, ignore_errors=True)
+                    os.rename(staging, target_dir)
+        finally:
+            shutil.rmtree(staging, ignore_errors=True)
+
+
+def _fail(source: str, output: str) -> None:
+    lines = output.splitlines()
+    # the compiler's diagnostics with their source lines and carets
+    relevant = [ln for ln in lines if _DIAG.search(ln)
+                and not _NOISE.search(ln)] or lines
+    raise BuildError(f"{source}: build failed:\n" +
+                     "\n".join(relevant[-40:]))
+
+
+def _run_all(commands: list[list[str]], cwd: str) -> list[tuple[int, str]]:
+    """Run the commands, as many at a time as there are CPUs; return each
+    one's exit status and output (stdout and stderr merged)."""
+    jobs = max(1, os.cpu_count() or 1)
+    results: list[tuple[int, str]] = []
+    running: list[subprocess.Popen[str]] = []
+    try:
+        for i, cmd in enumerate(commands):
+            try:
+                running.append(subprocess.Popen(
+                    cmd, cwd=cwd, stdin=subprocess.DEVNULL,
+                    stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                    text=True, errors="replace"))
+            except OSError as exc:
+                raise BuildError(f"cannot run the C compiler or linker "
+                                 f"'{cmd[0]}': {exc}") from None
+            if len(running) >= jobs or i == len(commands) - 1:
+                for proc in running:
+                    out, _ = proc.communicate()
+                    results.append((proc.returncode, out))
+                running = []
+    finally:
+        for proc in running:
+            proc.kill()
+            proc.wait()
+    return results
+
+
+def _cythonize(source: str, pyx: str, c_file: str, name: str) -> None:
+    """Translate ``pyx`` to ``c_file`` with Cython, in this process; its
+    messages are captured and raised as a BuildError naming ``source``."""
+    from Cython.Compiler import Errors, Main
+
+    options = Main.CompilationOptions(
+        Main.default_options, include_path=[os.path.dirname(PACKAGE_DIR)],
+        output_file=c_file, language_level=3,
+        compiler_directives={"boundscheck": False, "wraparound": False})
+    messages = io.StringIO()
+    errors = 1
+    with _CYTHON_LOCK, contextlib.redirect_stderr(messages), \
+            contextlib.redirect_stdout(messages):
+        try:
+            errors = Main.compile_single(pyx, options, full_module_name=name) \
+                .num_errors
+        except (Errors.PyrexError, OSError) as exc:
+            messages.write(f"{exc}\n")
+        finally:
+            Errors.close_listing_file()
+    if errors or not os.path.isfile(c_file):
+        # name the caller's file, not the private copy
+        _fail(source, messages.getvalue().replace(pyx, source)
+              or "Cython failed")

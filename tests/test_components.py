@@ -167,6 +167,115 @@ def test_build_is_cached(tmp_path):
     assert os.path.getmtime(first) == mtime
 
 
+def _fresh_cache(tmp_path, monkeypatch) -> str:
+    cache = tmp_path / "cache"
+    monkeypatch.setenv("HALSDK_CACHE", str(cache))
+    return str(cache)
+
+
+def test_build_calls_compiler_and_linker_directly(tmp_path, monkeypatch):
+    """A cold C build runs only the sysconfig compiler (once per file,
+    with the C entry and -DHALSDK_API_EXTERN) and LDSHARED, no Python
+    subprocess; the module lands in the cache under EXT_SUFFIX."""
+    import subprocess
+    import sysconfig
+
+    from halsdk import build
+
+    _fresh_cache(tmp_path, monkeypatch)
+    src = tmp_path / "cdirect.c"
+    src.write_text('#include "hal.h"\n'
+                   'int rtapi_app_main(void) { return 0; }\n'
+                   'void rtapi_app_exit(void) {}\n')
+    seen: list[list[str]] = []
+    real = subprocess.Popen
+
+    def spy(cmd, *args, **kwargs):
+        seen.append(list(cmd))
+        return real(cmd, *args, **kwargs)
+
+    monkeypatch.setattr(subprocess, "Popen", spy)
+    path = build_component(str(src))
+    assert path.endswith("cdirect" + sysconfig.get_config_var("EXT_SUFFIX"))
+    assert os.path.isfile(path)
+    compiler, linker = build.toolchain()
+    assert compiler[0] == sysconfig.get_config_var("CC").split()[0]
+    assert sysconfig.get_config_var("CCSHARED").split()[0] in compiler
+    assert linker == sysconfig.get_config_var("LDSHARED").split()
+    assert all(sys.executable not in cmd for cmd in seen)
+    compiles = [c for c in seen if "-c" in c]
+    assert sorted(c[c.index("-c") + 1] for c in compiles) == sorted(
+        [build.C_ENTRY, str(src)])
+    assert all("-DHALSDK_API_EXTERN=1" in c and
+               "-DHALSDK_MODULE_NAME=cdirect" in c for c in compiles)
+    links = [c for c in seen if "-c" not in c]
+    assert len(links) == 1 and links[0][:len(linker)] == linker
+    # cached: no process at all the second time
+    seen.clear()
+    assert build_component(str(src)) == path
+    assert seen == []
+
+
+def test_build_follows_cflags_environment(tmp_path, monkeypatch):
+    """CFLAGS from the environment reach the compiler (as with
+    setuptools) and are part of the cache key."""
+    _fresh_cache(tmp_path, monkeypatch)
+    src = tmp_path / "cflagged.c"
+    src.write_text('#include "hal.h"\n'
+                   '#if HALSDK_TEST_FLAG != 42\n'
+                   '#error flag_not_seen\n'
+                   '#endif\n'
+                   'int rtapi_app_main(void) { return 0; }\n'
+                   'void rtapi_app_exit(void) {}\n')
+    monkeypatch.delenv("CFLAGS", raising=False)
+    with pytest.raises(BuildError, match="flag_not_seen"):
+        build_component(str(src))
+    monkeypatch.setenv("CFLAGS", "-DHALSDK_TEST_FLAG=42")
+    assert os.path.isfile(build_component(str(src)))
+
+
+def test_failed_build_leaves_nothing(tmp_path, monkeypatch):
+    """A failed compile or link installs nothing: no module in out_dir,
+    no cache entry, no half-built folder."""
+    cache = _fresh_cache(tmp_path, monkeypatch)
+    bad = tmp_path / "nolink.c"
+    # compiles, but the link fails (the symbol exists nowhere)
+    bad.write_text('#include "hal.h"\n'
+                   'extern int halsdk_no_such_symbol_anywhere(void);\n'
+                   'int rtapi_app_main(void) '
+                   '{ return halsdk_no_such_symbol_anywhere(); }\n'
+                   'void rtapi_app_exit(void) {}\n')
+    out = tmp_path / "out"
+    monkeypatch.setenv("LDFLAGS", "-Wl,--no-undefined")
+    with pytest.raises(BuildError, match="nolink.c.*\n(.|\n)*"
+                       "halsdk_no_such_symbol_anywhere"):
+        build_component(str(bad), out_dir=str(out))
+    assert not out.exists() or os.listdir(out) == []
+    assert not os.path.isdir(cache) or os.listdir(cache) == []
+    syntax = tmp_path / "nocompile.c"
+    syntax.write_text("int rtapi_app_main(void) { return 0 }\n")
+    with pytest.raises(BuildError, match="nocompile.c:1:"):
+        build_component(str(syntax), out_dir=str(out))
+    assert not os.path.isdir(cache) or os.listdir(cache) == []
+
+
+def test_cython_build_in_process_names_the_source(tmp_path, monkeypatch):
+    """Cython runs in this process: its messages name the caller's file
+    and line, and a good module cimports halsdk/hal.pxd and loads."""
+    _fresh_cache(tmp_path, monkeypatch)
+    bad = tmp_path / "cybad.pyx"
+    bad.write_text("x = 1\ncdef int y = undefined_name_here\n")
+    with pytest.raises(BuildError) as info:
+        build_component(str(bad))
+    assert f"{bad}:2:" in str(info.value)
+    assert "halsdk-build-" not in str(info.value)
+    src = os.path.join(os.path.dirname(__file__), "components", "tand2.pyx")
+    path = build_component(src, name="tand2copy")
+    assert os.path.basename(path).startswith("tand2copy.")
+    with open(path, "rb") as f:
+        assert b"PyInit_tand2copy" in f.read()
+
+
 def test_component_from_entry_point_group(hal, tmp_path, monkeypatch):
     """Third-party packages ship components under the entry-point group
     'halsdk.components'."""
