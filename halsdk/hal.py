@@ -110,6 +110,16 @@ class Hal:
         with self._conn.lock:
             return self._conn.registry.load(name, *args, **kw)
 
+    def module(self, name: str):
+        """The Python module of a loaded realtime module (host only)."""
+        if not self._conn.host:
+            raise NotPermittedError(f"module '{name}': modules live in the "
+                                    "host process")
+        loaded = self._conn.registry.modules.get(name)
+        if loaded is None:
+            raise NotFoundError(f"module '{name}' is not loaded")
+        return loaded.module
+
     def loadrt_args(self) -> dict[str, str]:
         """Component name -> the load-line parameters it was loaded with
         (what ``save comp`` writes)."""

@@ -32,7 +32,9 @@ import importlib.machinery
 import importlib.util
 import os
 import re
+import shutil
 import sys
+import tempfile
 from dataclasses import dataclass, field
 from types import ModuleType
 from typing import Any, Optional
@@ -66,6 +68,44 @@ def _find_file(folder: str, name: str) -> Optional[str]:
     return None
 
 
+_imported: dict[str, int] = {}     # file -> times imported in this process
+
+
+def _import_file(name: str, path: str) -> ModuleType:
+    """Import a component module from a file.
+
+    A compiled module is mapped once per file by the dynamic loader, so a
+    second load would share the C static variables of the first.  As the
+    reference loads a module afresh each time, every load after the first
+    maps a private copy of the file: its statics start from their initial
+    values.
+    """
+    n = _imported.get(path, 0)
+    _imported[path] = n + 1
+    qual = f"halsdk._loaded.{name}"
+    source, tmpdir = path, None
+    if n and not path.endswith(".py"):
+        tmpdir = tempfile.mkdtemp(prefix="halsdk-load-")
+        source = os.path.join(tmpdir, os.path.basename(path))
+        shutil.copy2(path, source)
+        qual = f"halsdk._loaded_{n}.{name}"
+    try:
+        spec = importlib.util.spec_from_file_location(qual, source)
+        if spec is None or spec.loader is None:
+            raise LoadError(f"cannot load component '{name}' from {path}")
+        module = importlib.util.module_from_spec(spec)
+        try:
+            spec.loader.exec_module(module)
+        except Exception as exc:
+            raise LoadError(f"component '{name}' ({path}) failed to "
+                            f"import: {exc}") from exc
+    finally:
+        if tmpdir:                  # mapped now: the file can go
+            shutil.rmtree(tmpdir, ignore_errors=True)
+    sys.modules[qual] = module
+    return module
+
+
 def import_component(name: str) -> ModuleType:
     """Import the module of component ``name`` by the search order."""
     if not _MODULE_NAME.match(name):
@@ -73,18 +113,7 @@ def import_component(name: str) -> ModuleType:
     for folder in search_path():
         path = _find_file(folder, name)
         if path:
-            qual = f"halsdk._loaded.{name}"
-            spec = importlib.util.spec_from_file_location(qual, path)
-            if spec is None or spec.loader is None:
-                raise LoadError(f"cannot load component '{name}' from {path}")
-            module = importlib.util.module_from_spec(spec)
-            try:
-                spec.loader.exec_module(module)
-            except Exception as exc:
-                raise LoadError(f"component '{name}' ({path}) failed to "
-                                f"import: {exc}") from exc
-            sys.modules[qual] = module
-            return module
+            return _import_file(name, path)
     for package in ("halsdk.components", "halsdk.drivers"):
         qual = f"{package}.{name}"
         try:

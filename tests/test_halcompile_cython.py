@@ -112,7 +112,7 @@ def test_cython_multi_function_component(hal, cy_dir):
 
 def test_extra_cleanup_runs_on_unload(hal, cy_dir):
     hal.loadrt("hccymulti")
-    module = sys.modules["halsdk._loaded.hccymulti"]
+    module = hal.module("hccymulti")
     before = module.cleanup_count()
     hal.unloadrt("hccymulti")
     assert module.cleanup_count() == before + 1

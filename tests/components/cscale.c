@@ -25,9 +25,11 @@ typedef struct {
     hal_u64_t *calls;
     hal_float_t gain;
     hal_float_t offset;
+    hal_s32_t loads;
 } scaler_t;
 
 static int comp_id;
+static int loads;               /* a static: counts loads of this copy */
 
 static void update(void *arg, long period)
 {
@@ -47,6 +49,7 @@ int rtapi_app_main(void)
     comp_id = hal_init("cscale");
     if (comp_id < 0)
         return comp_id;
+    loads++;
     for (n = 0; n < count; n++) {
         scaler_t *s = hal_malloc(sizeof(scaler_t));
         if (!s) {
@@ -68,6 +71,9 @@ int rtapi_app_main(void)
             r = hal_param_float_newf(HAL_RW, &s->offset, comp_id,
                                      "%s.%d.offset", prefix, n);
         if (!r)
+            r = hal_param_s32_newf(HAL_RO, &s->loads, comp_id,
+                                   "%s.%d.loads", prefix, n);
+        if (!r)
             r = hal_export_functf(update, s, 1, 0, comp_id, "%s.%d",
                                   prefix, n);
         if (r) {
@@ -75,6 +81,7 @@ int rtapi_app_main(void)
             return r;
         }
         s->gain = 1.0;
+        s->loads = loads;
     }
     hal_ready(comp_id);
     return 0;
