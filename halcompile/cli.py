@@ -181,7 +181,10 @@ def _build(path: str, comp: Optional[Component], mode: str,
     out_dir = user_component_dir() if mode == "install" else \
         (output or os.getcwd())
     includes = [os.path.dirname(os.path.abspath(path))]
-    flags = _PRIVATE + list(cflags)
+    # as LinuxCNC's module builds do: RTAPI for realtime code, ULAPI for
+    # userspace programs (real sources test them around their includes)
+    user = userspace if comp is None else bool(comp.option("userspace"))
+    flags = _PRIVATE + ["-DULAPI" if user else "-DRTAPI"] + list(cflags)
     try:
         if comp is None and userspace:
             name = os.path.splitext(os.path.basename(path))[0]

@@ -310,6 +310,15 @@ class _Parser:
             item.condition_loc = self.loc(cpos)
         if self.accept("="):
             item.default, vpos = self.raw_until(";", "a value")
+            late_if = re.search(r"\sif\b", item.default)
+            if late_if and item.condition is None:
+                # the reference's order: '= DEFAULT if CONDITION'
+                item.default = item.default[:late_if.start()].rstrip()
+                self.pos = vpos + late_if.start()
+                self.skip()
+                self.pos += 2
+                item.condition, cpos = self.raw_until(";", "a condition")
+                item.condition_loc = self.loc(cpos)
             self._check_value(item.default, vpos)
             item.default_loc = self.loc(vpos)
         if self.at_string():
