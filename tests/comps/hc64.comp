@@ -1,0 +1,13 @@
+component hc64 "The 64-bit types (halsdk and LinuxCNC 2.10; not in the 2.9 reference)";
+pin in s64 l_in = -5000000000;
+pin in u64 ul_in = 0xFFFFFFFFF;
+pin out s64 l_out;
+pin out u64 ul_out;
+param rw s64 lp = -3;
+param r u64 up;
+function _ nofp;
+license "GPL";
+;;
+l_out = l_in * 2 + lp;
+ul_out = ul_in + 1;
+up = ul_out << 1;

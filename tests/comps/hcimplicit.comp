@@ -1,0 +1,10 @@
+component hcimplicit "No FUNCTION macro: the whole code section is the one function's body";
+pin in s32 a;
+pin in s32 b;
+pin out s32 prod;
+pin out s32 runs;
+function _ nofp;
+license "GPL";
+;;
+prod = a * b;
+runs++;
