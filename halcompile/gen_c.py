@@ -325,6 +325,73 @@ def _export_item(w: _Writer, p: Pin) -> None:
         w.add("    }")
 
 
+def instance_code(export_call, prefix: str, *, singleton: bool,
+                  count_function: bool, exclusive: bool,
+                  check_empty: bool) -> list[str]:
+    """C lines that make the instances: one (singleton), get_count() of
+    them, one per name of ``names=``, or ``count=`` numbered ones.
+
+    ``export_call(name, index)`` is the C call that makes one instance;
+    ``exclusive`` refuses count= together with names=; ``check_empty``
+    refuses an empty name in the list.
+    """
+    numbered = [
+        "        for (int i = 0; i < n; i++) {",
+        "            char buf[HAL_NAME_LEN + 1];",
+        f"            rtapi_snprintf(buf, sizeof(buf), \"%s.%d\", {prefix}, "
+        "i);",
+        f"            r = {export_call('buf', 'i')};",
+        "            if (r != 0)", "                break;", "        }"]
+    if singleton:
+        return [f"    r = {export_call(f'(char *){prefix}', '0')};"]
+    if count_function:
+        return ["    {", "        int n = get_count();", *numbered, "    }"]
+    lines = []
+    if exclusive:
+        lines += ["    if (count && names[0]) {",
+                  "        rtapi_print_msg(RTAPI_MSG_ERR, \"count= and names= "
+                  "are mutually exclusive\\n\");",
+                  "        r = -EINVAL;",
+                  "    } else if (names[0]) {"]
+    else:
+        lines += ["    if (names[0]) {"]
+    lines += ["        char buf[HAL_NAME_LEN + 1];",
+              "        size_t len = 0;",
+              "        int idx = 0;",
+              "        for (const char *c = names; ; c++) {",
+              "            if (*c == ',' || *c == '\\0') {",
+              "                buf[len] = '\\0';"]
+    if check_empty:
+        lines += ["                if (len == 0) {",
+                  "                    rtapi_print_msg(RTAPI_MSG_ERR, "
+                  "\"names[%d] is invalid (empty string)\\n\", idx);",
+                  "                    r = -EINVAL;",
+                  "                    break;",
+                  "                }"]
+    lines += [f"                r = {export_call('buf', 'idx')};",
+              "                if (r != 0 || *c == '\\0')",
+              "                    break;",
+              "                idx++;",
+              "                len = 0;",
+              "            } else if (len + 1 >= sizeof(buf)) {",
+              "                buf[len] = '\\0';",
+              "                rtapi_print_msg(RTAPI_MSG_ERR, \"names: "
+              "\\\"%s\\\" too long\\n\", buf);",
+              "                r = -EINVAL;",
+              "                break;",
+              "            } else {",
+              "                buf[len++] = *c;",
+              "            }",
+              "        }",
+              "    } else {",
+              "        /* the code section may read count */",
+              "        if (!count)",
+              "            count = default_count;",
+              "        int n = count;",
+              *numbered, "    }"]
+    return lines
+
+
 def _app_main(w: _Writer, comp: Component, personality: bool,
               singleton: bool, count_function: bool, n: int) -> None:
     name = comp.name
@@ -360,50 +427,9 @@ def _app_main(w: _Writer, comp: Component, personality: bool,
             return f"export({inst}, {idx}, personality_of({inst}, {idx}))"
         return f"export({inst}, {idx})"
 
-    numbered = [
-        "        for (int i = 0; i < n; i++) {",
-        "            char buf[HAL_NAME_LEN + 1];",
-        f"            rtapi_snprintf(buf, sizeof(buf), \"%s.%d\", {prefix}, "
-        "i);",
-        f"            r = {export_call('buf', 'i')};",
-        "            if (r != 0)", "                break;", "        }"]
-    if singleton:
-        w.add(f"    r = {export_call(f'(char *){prefix}', '0')};")
-    elif count_function:
-        w.add("    {", "        int n = get_count();", *numbered, "    }")
-    else:
-        w.add("    if (count && names[0]) {",
-              "        rtapi_print_msg(RTAPI_MSG_ERR, \"count= and names= "
-              "are mutually exclusive\\n\");",
-              "        r = -EINVAL;",
-              "    } else if (names[0]) {",
-              "        char buf[HAL_NAME_LEN + 1];",
-              "        size_t len = 0;",
-              "        int idx = 0;",
-              "        for (const char *c = names; ; c++) {",
-              "            if (*c == ',' || *c == '\\0') {",
-              "                buf[len] = '\\0';",
-              f"                r = {export_call('buf', 'idx')};",
-              "                if (r != 0 || *c == '\\0')",
-              "                    break;",
-              "                idx++;",
-              "                len = 0;",
-              "            } else if (len + 1 >= sizeof(buf)) {",
-              "                buf[len] = '\\0';",
-              "                rtapi_print_msg(RTAPI_MSG_ERR, \"names: "
-              "\\\"%s\\\" too long\\n\", buf);",
-              "                r = -EINVAL;",
-              "                break;",
-              "            } else {",
-              "                buf[len++] = *c;",
-              "            }",
-              "        }",
-              "    } else {",
-              "        /* the code section may read count */",
-              "        if (!count)",
-              "            count = default_count;",
-              "        int n = count;",
-              *numbered, "    }")
+    w.add(*instance_code(export_call, prefix, singleton=singleton,
+                         count_function=count_function, exclusive=True,
+                         check_empty=False))
     w.add("    if (r != 0) {")
     if cleanup:
         w.add(f"        {cleanup}")

@@ -52,7 +52,7 @@ ARGV_PARAM = "halsdk_argv"
 def app_main(w, comp) -> None:   # w: gen_c._Writer, comp: Component
     """Append the start-up code of userspace component ``comp`` to the
     generated C file of ``w``."""
-    from halcompile.gen_c import c_string
+    from halcompile.gen_c import c_string, instance_code
 
     name = comp.name
     prefix = c_string(comp.prefix)
@@ -127,51 +127,9 @@ def app_main(w, comp) -> None:   # w: gen_c._Writer, comp: Component
     w.add("    __comp_first_inst = __comp_last_inst = NULL;",
           f"    comp_id = hal_init({c_string(name)});",
           "    if (comp_id < 0)", "        return comp_id;")
-    numbered = [
-        "        for (int i = 0; i < n; i++) {",
-        "            char buf[HAL_NAME_LEN + 1];",
-        f"            rtapi_snprintf(buf, sizeof(buf), \"%s.%d\", {prefix}, "
-        "i);",
-        f"            r = {export_call('buf', 'i')};",
-        "            if (r != 0)", "                break;", "        }"]
-    if singleton:
-        w.add(f"    r = {export_call(f'(char *){prefix}', '0')};")
-    elif count_function:
-        w.add("    {", "        int n = get_count();", *numbered, "    }")
-    else:
-        w.add("    if (names[0]) {",
-              "        char buf[HAL_NAME_LEN + 1];",
-              "        size_t len = 0;",
-              "        int idx = 0;",
-              "        for (const char *c = names; ; c++) {",
-              "            if (*c == ',' || *c == '\\0') {",
-              "                buf[len] = '\\0';",
-              "                if (len == 0) {",
-              "                    rtapi_print_msg(RTAPI_MSG_ERR, "
-              "\"names[%d] is invalid (empty string)\\n\", idx);",
-              "                    r = -EINVAL;",
-              "                    break;",
-              "                }",
-              f"                r = {export_call('buf', 'idx')};",
-              "                if (r != 0 || *c == '\\0')",
-              "                    break;",
-              "                idx++;",
-              "                len = 0;",
-              "            } else if (len + 1 >= sizeof(buf)) {",
-              "                buf[len] = '\\0';",
-              "                rtapi_print_msg(RTAPI_MSG_ERR, \"names: "
-              "\\\"%s\\\" too long\\n\", buf);",
-              "                r = -EINVAL;",
-              "                break;",
-              "            } else {",
-              "                buf[len++] = *c;",
-              "            }",
-              "        }",
-              "    } else {",
-              "        if (!count)",
-              "            count = default_count;",
-              "        int n = count;",
-              *numbered, "    }")
+    w.add(*instance_code(export_call, prefix, singleton=singleton,
+                         count_function=count_function, exclusive=False,
+                         check_empty=True))
     w.add("    if (r != 0) {")
     if cleanup:
         w.add(f"        {cleanup}")
