@@ -36,7 +36,6 @@ from __future__ import annotations
 
 import importlib.util
 import os
-import re
 import signal
 import stat
 import sys
@@ -46,7 +45,7 @@ from typing import Optional
 #: most command-line words a userspace program receives
 MAX_ARGS = 256
 #: the module parameter that carries the command line
-ARGV_PARAM = "halsdk_argv"
+ARGV_PARAM = "halsdk_argv"    # halsdk.loader.USER_ARGV_PARAM
 
 
 def app_main(w, comp) -> None:   # w: gen_c._Writer, comp: Component
@@ -117,9 +116,9 @@ def app_main(w, comp) -> None:   # w: gen_c._Writer, comp: Component
           "    return 0;", "}", "",
           "int rtapi_app_main(void)", "{", "    int r = 0;",
           f"    if (!{ARGV_PARAM}[0]) {{",
-          f"        rtapi_print_msg(RTAPI_MSG_ERR, \"{name} is a userspace "
+          "        rtapi_print_msg(RTAPI_MSG_ERR, \"this is a userspace "
           f"component: start it with 'loadusr {name}'\\n\");",
-          "        return -EINVAL;", "    }",
+          "        return -ENOEXEC;", "    }",
           "    r = __comp_user_args();", "    if (r != 0)",
           "        return r;")
     if userinit:
@@ -238,9 +237,11 @@ def run(module_path: str, argv: Sequence[str]) -> int:
     words = [prog, *argv[1:]]
     try:
         module.setup(**{ARGV_PARAM: words})
-    except RuntimeError as exc:
-        m = re.search(r"returned (-?\d+)", str(exc))
-        code = int(m.group(1)) if m else 1
+    except HalError as exc:
+        code = getattr(exc, "status", None)
+        if code is None:
+            print(f"{prog}: {exc}", file=sys.stderr)
+            return 1
         # a failed start-up (negative errno) is status 1, like the
         # reference's; a program's own main() status is kept
         return 1 if code < 0 else (code & 255 or 1)

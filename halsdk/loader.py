@@ -106,6 +106,11 @@ def _import_file(name: str, path: str) -> ModuleType:
     return module
 
 
+#: the module parameter that carries the command line of a userspace
+#: program built by halcompile (its launcher sets it; loadrt refuses it)
+USER_ARGV_PARAM = "halsdk_argv"
+
+
 def import_component(name: str) -> ModuleType:
     """Import the module of component ``name`` by the search order."""
     if not _MODULE_NAME.match(name):
@@ -238,6 +243,9 @@ class Registry:
         if not callable(getattr(module, "setup", None)):
             raise LoadError(f"module '{name}' has no setup(): it is not a "
                             "halsdk component module")
+        if USER_ARGV_PARAM in getattr(module, "modparams", {}):
+            raise LoadError(f"{name}: this is a userspace component: start "
+                            f"it with 'loadusr {name}'")
         params = parse_modparams(name, module, args, kwargs)
         before = self._own_comp_ids()
         _core.set_loading_rt(True)
@@ -259,7 +267,13 @@ class Registry:
         if error is not None:
             self._undo(module, new)
             if isinstance(error, HalError):
-                raise type(error)(f"{name}: {error}") from error
+                text = str(error)
+                if not text.startswith(f"{name}:"):
+                    text = f"{name}: {text}"
+                again = type(error)(text)
+                if hasattr(error, "status"):
+                    again.status = error.status     # type: ignore[attr-defined]
+                raise again from error
             raise LoadError(f"{name}: setup failed: {error}") from error
         words = [w for a in args for w in str(a).split()]
         words += [f"{k}={v}" for k, v in kwargs.items()]

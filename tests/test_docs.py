@@ -150,7 +150,9 @@ def test_c_example_builds_and_works(hal, tmp_path, monkeypatch) -> None:
     assert hal.pins("wsum.2.*") == []
 
     hal.unloadrt("wsum")
-    with pytest.raises(halsdk.LoadError, match="returned -22"):
+    with pytest.raises(halsdk.InvalidError,
+                       match="^wsum: count=99 is not 1..32$") as err:
         hal.loadrt("wsum", count=99)        # rtapi_app_main refuses
+    assert err.value.status == -22
     assert hal.components("wsum") == []
 

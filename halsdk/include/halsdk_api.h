@@ -21,7 +21,7 @@
 extern "C" {
 #endif
 
-#define HALSDK_API_VERSION 2
+#define HALSDK_API_VERSION 3
 #define HALSDK_CAPSULE_NAME "halsdk._core._C_API"
 
 /* longest object name, not counting the terminating NUL */
@@ -127,6 +127,13 @@ typedef struct halsdk_api {
     long long (*stream_num_underruns)(long long handle);
     int (*stream_nelem)(long long handle);
     int (*stream_elem_type)(long long handle, int index);
+
+    /* --- version 3: the messages of a module's setup --- */
+    /* msg_capture(1) keeps what rtapi_print_msg prints in this thread
+       (and clears last_error) until msg_capture(0); captured_msgs()
+       returns the text kept */
+    void (*msg_capture)(int on);
+    const char *(*captured_msgs)(void);
 } halsdk_api;
 
 #ifdef __cplusplus

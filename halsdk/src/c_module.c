@@ -12,6 +12,7 @@
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
 
+#include <errno.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -172,6 +173,66 @@ static int set_param(halsdk_modparam_t *m, PyObject *v)
     return 0;
 }
 
+/* the halsdk.errors class that fits the errno rtapi_app_main returned */
+static const char *error_class(int r)
+{
+    switch (r < 0 ? -r : r) {
+    case EINVAL: case ERANGE: case E2BIG:
+        return "InvalidError";
+    case EEXIST: case EBUSY:
+        return "ExistsError";
+    case ENOMEM: case ENOSPC:
+        return "CapacityError";
+    case ENOENT: case ENODEV:
+        return "NotFoundError";
+    case EPERM: case EACCES:
+        return "NotPermittedError";
+    default:
+        return "LoadError";
+    }
+}
+
+/* raise the error of a failed rtapi_app_main(): the messages the module
+   printed and the HAL's own error, in the class its errno stands for */
+static void setup_failed(int r, const char *msgs, const char *hal_error)
+{
+    char text[4096 + 600];
+    size_t n = 0;
+    text[0] = 0;
+    /* the messages, one line each, joined with "; " */
+    for (const char *p = msgs; *p && n < sizeof(text) - 3; ) {
+        size_t len = strcspn(p, "\n");
+        if (len) {
+            int w = snprintf(text + n, sizeof(text) - n, "%s%.*s",
+                             n ? "; " : "", (int)len, p);
+            n += w > 0 ? (size_t)w : 0;
+        }
+        p += len + (p[len] == '\n');
+    }
+    if (n >= sizeof(text))
+        n = sizeof(text) - 1;
+    if (hal_error && *hal_error && !strstr(text, hal_error))
+        n += snprintf(text + n, sizeof(text) - n, "%s%s", n ? "; " : "",
+                      hal_error);
+    if (!n)
+        snprintf(text, sizeof(text), "rtapi_app_main() returned %d (%s)",
+                 r, strerror(r < 0 ? -r : r));
+    PyObject *errors = PyImport_ImportModule("halsdk.errors");
+    PyObject *cls = errors ? PyObject_GetAttrString(errors, error_class(r))
+                           : NULL;
+    Py_XDECREF(errors);
+    if (!cls)
+        return;
+    /* the value itself too: a userspace program's exit status */
+    PyObject *exc = PyObject_CallFunction(cls, "s", text);
+    Py_DECREF(cls);
+    PyObject *status = exc ? PyLong_FromLong(r) : NULL;
+    if (status && PyObject_SetAttrString(exc, "status", status) == 0)
+        PyErr_SetObject((PyObject *)Py_TYPE(exc), exc);
+    Py_XDECREF(status);
+    Py_XDECREF(exc);
+}
+
 static PyObject *mod_setup(PyObject *self, PyObject *args, PyObject *kw)
 {
     if (PyTuple_GET_SIZE(args)) {
@@ -197,15 +258,29 @@ static PyObject *mod_setup(PyObject *self, PyObject *args, PyObject *kw)
             return NULL;
     }
     int r;
+#ifdef ULAPI
+    /* a userspace program runs its whole life in here: its messages go
+       out as it prints them */
+    const char *msgs = "";
     Py_BEGIN_ALLOW_THREADS
+    halsdk_api_ptr->msg_capture(1);     /* clears the last HAL error */
+    halsdk_api_ptr->msg_capture(0);
     r = rtapi_app_main();
     Py_END_ALLOW_THREADS
-    if (r != 0) {
-        PyErr_Format(PyExc_RuntimeError, "rtapi_app_main() returned %d "
-                     "(last HAL error: %s)", r, halsdk_api_ptr->last_error());
-        return NULL;
-    }
-    Py_RETURN_NONE;
+#else
+    Py_BEGIN_ALLOW_THREADS
+    halsdk_api_ptr->msg_capture(1);
+    r = rtapi_app_main();
+    halsdk_api_ptr->msg_capture(0);
+    Py_END_ALLOW_THREADS
+    const char *msgs = halsdk_api_ptr->captured_msgs();
+    if (r == 0)
+        fputs(msgs, stderr);
+#endif
+    if (r == 0)
+        Py_RETURN_NONE;
+    setup_failed(r, msgs, halsdk_api_ptr->last_error());
+    return NULL;
 }
 
 static PyObject *mod_cleanup(PyObject *self, PyObject *unused)

@@ -79,12 +79,42 @@ static unsigned char api_get_lock(void)
     return hal_map.hdr ? (unsigned char)hal_map.hdr->lock : 0;
 }
 
+/* while a module sets up, its messages are kept: the loader shows them
+   as the error of a failed load, or prints them after a good one */
+static __thread int capturing;
+static __thread char captured[4096];
+static __thread size_t ncaptured;
+
 static void api_vprint_msg(int level, const char *fmt, va_list ap)
 {
     int cur = hal_map.hdr ? hal_map.hdr->msg_level : 1;
     if (level > cur)
         return;
-    vfprintf(stderr, fmt, ap);
+    if (!capturing) {
+        vfprintf(stderr, fmt, ap);
+        return;
+    }
+    size_t room = sizeof(captured) - ncaptured;
+    if (room <= 1)
+        return;
+    int n = vsnprintf(captured + ncaptured, room, fmt, ap);
+    if (n > 0)
+        ncaptured += (size_t)n < room ? (size_t)n : room - 1;
+}
+
+static void api_msg_capture(int on)
+{
+    capturing = on;
+    if (on) {
+        ncaptured = 0;
+        captured[0] = 0;
+        hal_fail(0, "%s", "");
+    }
+}
+
+static const char *api_captured_msgs(void)
+{
+    return captured;
 }
 
 static int api_set_msg_level(int level)
@@ -143,4 +173,6 @@ const halsdk_api halsdk_api_table = {
     .stream_num_underruns = hal_stream_num_underruns,
     .stream_nelem = hal_stream_nelem,
     .stream_elem_type = hal_stream_elem_type,
+    .msg_capture = api_msg_capture,
+    .captured_msgs = api_captured_msgs,
 };
