@@ -429,7 +429,7 @@ def _app_main(w: _Writer, comp: Component, personality: bool,
 
     w.add(*instance_code(export_call, prefix, singleton=singleton,
                          count_function=count_function, exclusive=True,
-                         check_empty=False))
+                         check_empty=True))
     w.add("    if (r != 0) {")
     if cleanup:
         w.add(f"        {cleanup}")
