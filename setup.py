@@ -1,16 +1,32 @@
 """Build of the halsdk core extension and the shipped components.
 
-The core is Cython + C.  Shipped components live in ``components/`` (Python
-modules and Cython ``.pyx`` sources) and are installed as the package
-``halsdk.components``; each ``.pyx`` becomes the extension module
-``halsdk.components.<name>``.
+The core is Cython + C.  Shipped components live in ``components/`` and are
+installed as the package ``halsdk.components``; each source becomes the
+extension module ``halsdk.components.<name>``:
+
+- ``NAME.comp`` goes through halcompile, as ``halcompile --compile`` would
+  do it: a C code section becomes generated C (built with the module entry
+  ``halsdk/src/c_module.c``), a Cython one (``option cython``) a generated
+  ``.pyx``.  The generated files go to ``build/halcompile/``.
+- ``NAME.pyx`` is a component written in Cython against ``halsdk/hal.pxd``.
 """
 
 import glob
 import os
+import shlex
+import sys
 
 from Cython.Build import cythonize
 from setuptools import Extension, setup
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)        # halcompile, from this source tree
+
+from halcompile import gen_c, gen_cython  # noqa: E402
+from halcompile.parser import CompError, parse_file  # noqa: E402
+
+GENERATED = os.path.join("build", "halcompile")
+FLAGS = ["-O2", "-std=gnu11", "-Wall", "-Wno-unused-function"]
 
 core = Extension(
     "halsdk._core",
@@ -22,19 +38,68 @@ core = Extension(
         "halsdk/src/hal_stream.c",
     ],
     include_dirs=["halsdk/include", "halsdk/src"],
-    extra_compile_args=["-O2", "-std=gnu11", "-Wall", "-Wno-unused-function"],
+    extra_compile_args=FLAGS,
     libraries=["rt", "pthread"],
 )
 
-components = [
+
+def _write(path, text):
+    """Write a generated file only when it changes (keeps builds
+    incremental)."""
+    try:
+        with open(path, encoding="utf-8") as f:
+            if f.read() == text:
+                return
+    except OSError:
+        pass
+    with open(path, "w", encoding="utf-8") as f:
+        f.write(text)
+
+
+def comp_extension(path):
+    """The extension module of one shipped ``.comp`` file."""
+    try:
+        comp = parse_file(path)
+    except CompError as exc:
+        sys.exit(f"error: {exc}")
+    if comp.option("userspace"):
+        sys.exit(f"error: {path}: shipped components are realtime ones")
+    os.makedirs(GENERATED, exist_ok=True)
+    flags = FLAGS + ["-fvisibility=hidden"] + shlex.split(
+        str(comp.option("extra_compile_args", "")))
+    links = shlex.split(str(comp.option("extra_link_args", "")))
+    if comp.option("cython"):
+        text, _ = gen_cython.generate(comp)
+        pyx = os.path.join(GENERATED, comp.name + ".pyx")
+        _write(pyx, text)
+        return Extension("halsdk.components." + comp.name, sources=[pyx],
+                         include_dirs=["halsdk/include", "components"],
+                         extra_compile_args=flags, extra_link_args=links)
+    c_file = os.path.join(GENERATED, comp.name + ".c")
+    _write(c_file, gen_c.generate(comp, os.path.abspath(c_file)))
+    return Extension(
+        "halsdk.components." + comp.name,
+        sources=["halsdk/src/c_module.c", c_file],
+        include_dirs=["halsdk/include", "components"],
+        define_macros=[("HALSDK_MODULE_NAME", comp.name),
+                       ("HALSDK_API_EXTERN", "1"), ("RTAPI", None)],
+        extra_compile_args=flags, extra_link_args=links)
+
+
+components = [comp_extension(p)
+              for p in sorted(glob.glob("components/*.comp"))]
+components += [
     Extension(
         "halsdk.components." + os.path.splitext(os.path.basename(src))[0],
         sources=[src],
         include_dirs=["halsdk/include"],
-        extra_compile_args=["-O2", "-std=gnu11", "-Wno-unused-function"],
+        extra_compile_args=FLAGS,
     )
     for src in sorted(glob.glob("components/*.pyx"))
 ]
+names = [e.name for e in components]
+if len(set(names)) != len(names):
+    sys.exit("error: two sources in components/ make the same module")
 
 setup(
     packages=["halsdk", "halsdk.compat", "halsdk.demo", "halsdk.halcmd",

@@ -9,7 +9,44 @@ without a build it holds no compiled core.
 
 from __future__ import annotations
 
+import glob
+import os
+
 import halsdk
+from halcompile.gen_doc import rst_page
+from halcompile.parser import parse_file
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+
+
+def write_component_pages() -> None:
+    """One page per shipped ``.comp`` (``components/``), made by
+    halcompile's ``--document`` writer, into ``docs/comp/`` (generated,
+    not kept in git).  A page whose .comp is gone is removed."""
+    out = os.path.join(HERE, "comp")
+    os.makedirs(out, exist_ok=True)
+    sources = sorted(glob.glob(os.path.join(HERE, "..", "components",
+                                            "*.comp")))
+    wanted = set()
+    for path in sources:
+        comp = parse_file(path)
+        page = os.path.join(out, comp.name + ".rst")
+        wanted.add(page)
+        text = rst_page(comp)
+        try:
+            with open(page, encoding="utf-8") as f:
+                if f.read() == text:
+                    continue
+        except OSError:
+            pass
+        with open(page, "w", encoding="utf-8") as f:
+            f.write(text)
+    for page in glob.glob(os.path.join(out, "*.rst")):
+        if page not in wanted:
+            os.remove(page)
+
+
+write_component_pages()
 
 project = "halsdk"
 author = "the halsdk authors"

@@ -8,6 +8,7 @@ pages themselves, built and run, so the documented code cannot rot.
 
 from __future__ import annotations
 
+import glob
 import os
 import subprocess
 import sys
@@ -53,6 +54,26 @@ def test_every_page_is_built(site: str) -> None:
     index = _read(site, "index")
     for page in PAGES[1:]:
         assert f'href="{page}.html"' in index, f"index does not link {page}"
+
+
+def test_each_shipped_comp_has_a_generated_page(site: str) -> None:
+    """The page of every ``components/*.comp`` is written by halcompile's
+    --document writer and listed on the components page."""
+    from halcompile.parser import parse_file
+
+    comps = sorted(glob.glob(os.path.join(ROOT, "components", "*.comp")))
+    assert len(comps) >= 4
+    listing = _read(site, "components")
+    for path in comps:
+        comp = parse_file(path)
+        assert f'href="comp/{comp.name}.html"' in listing, comp.name
+        html = _read(site, f"comp/{comp.name}")
+        assert f"loadrt {comp.name}" in html
+        for item in comp.pins + comp.params:
+            assert f"{comp.name}.N.{item.hal_name}" in html, \
+                (comp.name, item.name)
+        if comp.description:
+            assert comp.description in html
 
 
 def test_api_page_is_generated_from_the_code(site: str) -> None:
