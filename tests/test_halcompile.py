@@ -642,3 +642,41 @@ def test_name_rules(halname, c_name, hal_name, fmt):
     assert c_identifier(halname) == c_name
     assert hal_identifier(halname) == hal_name
     assert hal_format(halname) == fmt
+
+
+def test_install_then_halrun_from_a_fresh_account(tmp_path):
+    """The issue's promise, with the installed commands and nothing set
+    up: an empty home (so an empty build cache and user folder), no
+    HALSDK_PATH; ``halcompile --install x.comp && halrun -f uses-x.hal``."""
+    bindir = os.path.dirname(sys.executable)
+    if not os.path.isfile(os.path.join(bindir, "halcompile")):
+        pytest.fail(f"the halcompile command is not installed in {bindir}")
+    home = tmp_path / "home"
+    home.mkdir()
+    (tmp_path / "hcdouble.comp").write_text(
+        'component hcdouble "twice the input";\n'
+        "pin in float in;\npin out float out;\nfunction _;\n"
+        'license "GPL";\n;;\nFUNCTION(_) { out = 2 * in; }\n')
+    (tmp_path / "uses-hcdouble.hal").write_text(
+        "loadrt hcdouble names=d\n"
+        "loadrt threads name1=t period1=1000000\n"
+        "addf d t\nsetp d.in 21.25\nstart\n"
+        "loadusr -w sleep 0.2\nstop\ngetp d.out\nshow pin d.*\n")
+    env = {k: v for k, v in os.environ.items()
+           if not k.startswith(("HALSDK_", "XDG_", "PYTHON"))}
+    env.update(HOME=str(home), PATH=bindir + os.pathsep + env["PATH"],
+               HALSDK_INSTANCE=f"fresh{os.getpid()}")
+    proc = subprocess.run(
+        ["sh", "-c", "halcompile --install hcdouble.comp && "
+                     "halrun -f uses-hcdouble.hal"],
+        cwd=str(tmp_path), env=env, capture_output=True, text=True,
+        timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    module = home / ".local" / "share" / "halsdk" / "components" / \
+        ("hcdouble" + extension_suffix())
+    lines = proc.stdout.splitlines()
+    assert lines[0] == str(module)
+    assert lines[1] == "42.5"
+    assert any(line.split()[-1:] == ["d.out"] and "42.5" in line
+               for line in lines[2:])
+    assert (home / ".cache" / "halsdk" / "build").is_dir()
