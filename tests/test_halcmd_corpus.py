@@ -215,7 +215,7 @@ def test_unload_all_and_unloadusr_all(tmp_path: Path):
         "loadrt and2\nloadrt or2\n"
         f"loadusr -Wn ucomp {sys.executable} ucomp.py\n"
         "list comp ucomp\nunloadusr all\n"
-        "list comp ucomp\nlist comp *2\nunload all\nlist pin\n")
+        "list comp ucomp\nlist comp *r2 *d2\nunload all\nlist pin\n")
     env = _env("unall", tmp_path / "bin")
     proc = _halrun(["-f", "u.hal"], tmp_path, env)
     assert proc.stdout.splitlines() == ["ucomp ", "", "or2 and2 ", ""]

@@ -26,8 +26,8 @@ try:
         stable = stable + 1 if now == last else 1
         last = now
         if stable >= h.samples and h.out != now:
+            h.changes += 1      # first: a reader that sees out sees it
             h.out = now
-            h.changes += 1
         time.sleep(0.002)
 except KeyboardInterrupt:
     raise SystemExit  # noqa: B904 - the usual LinuxCNC idiom
