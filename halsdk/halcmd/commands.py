@@ -353,8 +353,11 @@ class Executor:
         try:
             self.hal.loadrt(args[0], *args[1:])
         except HalError as exc:
+            text = str(exc)         # it names the module, or we do
+            if not text.startswith(f"{args[0]}:"):
+                text = f"{args[0]}: {text}"
             raise CommandError(f"insmod for {args[0]} failed, returned -1",
-                               lines=[f"{args[0]}: {exc}"]) from None
+                               lines=[text]) from None
         self._report_new(before)
         self.info(f"Component '{args[0]}' ready")
         self.info(f"Realtime module '{args[0]}' loaded")

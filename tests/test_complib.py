@@ -1,0 +1,94 @@
+"""Differential tests of the component library against the reference.
+
+Every ``tests/complib/NAME.hal`` runs with our ``halrun -f`` in a folder
+holding its inputs; the reference's results of the same run (made by
+``tests/complib/golden.py``) are the goldens:
+
+- ``NAME.out``: standard output, compared byte for byte after
+  :func:`test_halcmd.normalize` (component ids, addresses and halcmd's
+  pid cannot match);
+- ``NAME.rc``: a non-zero exit status (absent: 0); zero/non-zero must
+  match;
+- ``NAME.err``: standard error; each line that carries a message of the
+  component itself must appear in ours (the lines of the reference's
+  rtapi_app/insmod machinery and its HAL library's own wording do not).
+
+The files drive inputs with ``streamer``/``halstreamer`` and record
+outputs with ``sampler``/``halsampler -n N`` in a realtime thread, which is
+deterministic: the functions see the thread's nominal period, and a
+sample k is taken in cycle k.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from test_halcmd import normalize
+
+COMPLIB = Path(__file__).parent / "complib"
+GOLDEN = (".out", ".err", ".rc")
+CASES = sorted(p for p in COMPLIB.glob("*.hal")
+               if p.with_suffix(".out").exists())
+#: stderr lines of the reference's loading machinery, not of a component
+_MACHINERY = re.compile(
+    r"waitpid failed|exited without becoming ready|: rtapi_app_main: |"
+    r"^HAL: ERROR: |^Note: Using POSIX non-realtime$")
+TOOLS = ("halsampler", "halstreamer")
+
+
+def _env(name: str, tools: Path) -> dict:
+    env = dict(os.environ)
+    env["HALSDK_INSTANCE"] = f"cl-{os.getpid()}-{name}"
+    if not all(shutil.which(t) for t in TOOLS):
+        tools.mkdir(exist_ok=True)
+        for tool in TOOLS:
+            script = tools / tool
+            script.write_text(f'#!/bin/sh\nexec "{sys.executable}" -m '
+                              f'halsdk.tools.{tool} "$@"\n')
+            script.chmod(0o755)
+        env["PATH"] = f"{tools}{os.pathsep}{env.get('PATH', '')}"
+    return env
+
+
+def _inputs(name: str) -> list[Path]:
+    return [p for p in COMPLIB.iterdir()
+            if (p.name.startswith(name + ".") or p.name.startswith(name + "-"))
+            and p.suffix not in GOLDEN and p.suffix != ".py"]
+
+
+def component_messages(err: str) -> list[str]:
+    """The lines of a golden stderr that a component printed."""
+    return [line for line in err.splitlines()
+            if line.strip() and not _MACHINERY.search(line)]
+
+
+@pytest.mark.parametrize("hal_file", CASES, ids=lambda p: p.stem)
+def test_matches_reference(hal_file: Path, tmp_path: Path):
+    name = hal_file.stem
+    work = tmp_path / "work"
+    work.mkdir()
+    for p in _inputs(name):
+        shutil.copy(p, work / p.name)
+    env = _env(name, tmp_path / "bin")
+    proc = subprocess.run(
+        [sys.executable, "-m", "halsdk.halcmd.cli", "halrun", "-f",
+         hal_file.name], cwd=work, env=env, capture_output=True, text=True,
+        timeout=120)
+    expected = hal_file.with_suffix(".out").read_text()
+    assert normalize(proc.stdout) == normalize(expected), proc.stderr
+    rc_file = hal_file.with_suffix(".rc")
+    expected_rc = int(rc_file.read_text()) if rc_file.exists() else 0
+    assert (proc.returncode != 0) == (expected_rc != 0), proc.stderr
+    err_file = hal_file.with_suffix(".err")
+    if err_file.exists():
+        for line in component_messages(err_file.read_text()):
+            assert line in proc.stderr, \
+                f"the reference's message {line!r} is missing:\n{proc.stderr}"
+    left = [n for n in os.listdir("/dev/shm") if env["HALSDK_INSTANCE"] in n]
+    assert left == []
