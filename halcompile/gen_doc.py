@@ -117,13 +117,21 @@ def file_name(comp: Component, fmt: str) -> str:
                      f"(formats: {', '.join(FORMATS)})")
 
 
+def _own_loading(comp: Component) -> bool:
+    """``option rtapi_app no``: the code section's rtapi_app_main makes
+    the instances, and its ``modparam`` lines are the whole load line."""
+    return not comp.option("userspace") and \
+        not comp.option("rtapi_app", True)
+
+
 def _synopsis(comp: Component) -> str:
     """The load line, plain text."""
     userspace = comp.option("userspace")
     words = ["loadusr" if userspace else "loadrt", comp.name]
-    if _numbered(comp) and not comp.option("count_function"):
+    own = _own_loading(comp)
+    if _numbered(comp) and not comp.option("count_function") and not own:
         words.append("[count=N|names=name1[,name2...]]")
-    if comp.has_personality:
+    if comp.has_personality and not own:
         words.append("[personality=P,P,...]")
     for mp in comp.modparams:
         words.append(f"[{mp.name}={'S' if mp.type == 'string' else 'N'}]")
@@ -143,8 +151,11 @@ class _LoadParam:
 
 
 def _load_params(comp: Component) -> list[_LoadParam]:
-    out = []
-    if _numbered(comp) and not comp.option("count_function"):
+    out: list[_LoadParam] = []
+    own = _own_loading(comp)
+    if own:
+        pass
+    elif _numbered(comp) and not comp.option("count_function"):
         out.append(_LoadParam(
             "count", str(comp.option("default_count", 1)),
             "The number of instances to make; they are named "
@@ -160,7 +171,7 @@ def _load_params(comp: Component) -> list[_LoadParam]:
             "count", None,
             "There is no count parameter: the component decides how many "
             "instances it makes."))
-    if comp.has_personality:
+    if comp.has_personality and not own:
         out.append(_LoadParam(
             "personality", str(comp.option("default_personality", 0)),
             "One integer per instance, separated by commas: it selects "

@@ -150,8 +150,10 @@ class Component:
     @property
     def prefix(self) -> str:
         """The start of the HAL names of pins, params and functions: the
-        component name without a leading ``hal_``."""
-        return self.name[4:] if self.name.startswith("hal_") else self.name
+        component name without a leading ``hal_``, as a HAL name (``_``
+        becomes ``-``: ``conv_bit_float`` makes ``conv-bit-float.0``)."""
+        name = self.name[4:] if self.name.startswith("hal_") else self.name
+        return hal_identifier(name)
 
     @property
     def has_personality(self) -> bool:
