@@ -203,7 +203,7 @@ def parse_modparams(name: str, module: ModuleType, args: tuple,
     for key, raw in given.items():
         if key not in spec:
             known = ", ".join(sorted(spec)) or "none"
-            raise InvalidError(f"{name}: unknown parameter '{key}' "
+            raise InvalidError(f"{name}: Unknown parameter `{key}={raw}' "
                                f"(its parameters: {known})")
         out[key] = _convert(name, key, _spec_kind(spec[key][0]), raw)
     return out
@@ -274,6 +274,8 @@ class Registry:
                 if hasattr(error, "status"):
                     again.status = error.status     # type: ignore[attr-defined]
                 raise again from error
+            if isinstance(error, ValueError):      # a bad parameter value
+                raise InvalidError(f"{name}: {error}") from error
             raise LoadError(f"{name}: setup failed: {error}") from error
         words = [w for a in args for w in str(a).split()]
         words += [f"{k}={v}" for k, v in kwargs.items()]

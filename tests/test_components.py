@@ -87,7 +87,7 @@ def test_failed_setup_leaves_nothing(hal):
                        match=r"^cscale: count=100 is not 1\.\.64$"):
         hal.loadrt("cscale", count=100)
     assert hal.info()["counts"] == before
-    with pytest.raises(halsdk.LoadError, match="count=0"):
+    with pytest.raises(halsdk.InvalidError, match="count=0"):
         hal.loadrt("tand2", count=0)
     assert hal.components() == []
     hal.loadrt("cscale")          # and it can be loaded afterwards
@@ -95,7 +95,7 @@ def test_failed_setup_leaves_nothing(hal):
 
 
 def test_modparam_errors(hal):
-    with pytest.raises(halsdk.InvalidError, match="unknown parameter 'cnt'"):
+    with pytest.raises(halsdk.InvalidError, match="Unknown parameter `cnt=2'"):
         hal.loadrt("tand2", cnt=2)
     with pytest.raises(halsdk.InvalidError, match="not an integer"):
         hal.loadrt("tand2 count=two")

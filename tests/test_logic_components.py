@@ -148,7 +148,7 @@ def test_count_forms_as_the_reference(hal):
     ("names=a$b", halsdk.InvalidError, "contains the character '\\$'"),
     ("names=" + "x" * 200, halsdk.InvalidError, 'names: "x+" too long'),
     ("count=1.5", halsdk.InvalidError, "not an integer"),
-    ("cnt=1", halsdk.InvalidError, "unknown parameter 'cnt'"),
+    ("cnt=1", halsdk.InvalidError, "Unknown parameter `cnt=1'"),
 ])
 def test_load_errors_leave_nothing(hal, line, error, match):
     hal.loadrt("or2")

@@ -155,8 +155,22 @@ static int set_param(halsdk_modparam_t *m, PyObject *v)
         return -1;
     Py_ssize_t n = PySequence_Fast_GET_SIZE(seq);
     if (n > m->count) {
-        PyErr_Format(PyExc_ValueError, "parameter %s takes at most %d "
-                     "values, %zd given", m->name, m->count, n);
+        /* the load line's words, as the reference quotes them */
+        PyObject *comma = PyUnicode_FromString(",");
+        PyObject *strs = PyList_New(0);
+        for (Py_ssize_t k = 0; strs && k < n; k++) {
+            PyObject *w = PyObject_Str(PySequence_Fast_GET_ITEM(seq, k));
+            if (!w || PyList_Append(strs, w) < 0)
+                Py_CLEAR(strs);
+            Py_XDECREF(w);
+        }
+        PyObject *text = comma && strs ? PyUnicode_Join(comma, strs) : NULL;
+        if (text)
+            PyErr_Format(PyExc_ValueError, "%s=%U: can only take %d "
+                         "arguments", m->name, text, m->count);
+        Py_XDECREF(text);
+        Py_XDECREF(strs);
+        Py_XDECREF(comma);
         Py_DECREF(seq);
         return -1;
     }

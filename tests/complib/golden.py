@@ -34,6 +34,9 @@ REFERENCE = os.environ.get("HALSDK_REFERENCE",
 NOTE = "Note: Using POSIX non-realtime"
 GOLDEN = (".out", ".err", ".rc")
 LOCK = "/tmp/halsdk-reference.lock"
+TIMEOUT = 60
+#: the user the reference tool runs the reference as
+REFERENCE_USER = "halref"
 
 
 def inputs(name: str) -> list[Path]:
@@ -57,9 +60,19 @@ def make(name: str) -> int:
             os.chmod(os.path.join(tmp, p.name), 0o644)
         with open(LOCK, "w") as lock:
             fcntl.flock(lock, fcntl.LOCK_EX)
-            proc = subprocess.run([REFERENCE, "halrun", "-f", hal.name],
-                                  cwd=tmp, capture_output=True, text=True,
-                                  timeout=300)
+            try:
+                proc = subprocess.run(
+                    [REFERENCE, "halrun", "-f", hal.name], cwd=tmp,
+                    capture_output=True, text=True, timeout=TIMEOUT)
+            except subprocess.TimeoutExpired:
+                # e.g. its rtapi_app crashed under halsampler: end every
+                # process of the reference's user, then clean up its HAL
+                subprocess.run(["pkill", "-KILL", "-u", REFERENCE_USER])
+                subprocess.run([REFERENCE, "halrun", "-U"], cwd=tmp,
+                               capture_output=True, timeout=60)
+                print(f"{name}: the reference did not finish in {TIMEOUT} s"
+                      " (no golden written)", file=sys.stderr)
+                return 1
     (HERE / f"{name}.out").write_text(proc.stdout)
     err = "".join(line for line in proc.stderr.splitlines(True)
                   if line.rstrip("\n") != NOTE)
