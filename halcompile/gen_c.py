@@ -308,8 +308,8 @@ def _export_item(w: _Writer, p: Pin) -> None:
             w.add(f"{indent});",
                   f"{indent}if (n > {p.array.size}) {{",
                   f"{indent}    rtapi_print_msg(RTAPI_MSG_ERR, "
-                  f"\"{what} {p.name}: requested size %d exceeds the "
-                  f"maximum %d\\n\", n, {p.array.size});",
+                  f"\"{what.capitalize()} {p.name}: Requested size %d "
+                  f"exceeds max size %d\\n\", n, {p.array.size});",
                   f"{indent}    return -ENOSPC;", f"{indent}}}")
         w.add(f"{indent}for (j = 0; j < {count}; j++) {{")
         body = indent + "    "

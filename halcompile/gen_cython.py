@@ -475,8 +475,8 @@ def _export_item(o: _Out, p: Pin) -> None:
                   origin=p.array.condsize_loc.line
                   if p.array.condsize_loc else 0)
             o.add(f"{ind}if n > {p.array.size}:",
-                  f"{ind}    raise ValueError(f'{what} {p.name}: requested "
-                  f"size {{n}} exceeds the maximum {p.array.size}')")
+                  f"{ind}    raise ValueError(f'{what.capitalize()} {p.name}: "
+                  f"Requested size {{n}} exceeds max size {p.array.size}')")
         else:
             o.add(f"{ind}n = {p.array.size}")
         o.add(f"{ind}for j in range(n):")

@@ -322,7 +322,7 @@ def test_more_instances_than_personalities_wrap_around(hal, comp_dir,
 
 
 def test_personality_size_over_the_maximum_fails(hal, comp_dir, capfd):
-    with pytest.raises(halsdk.HalError, match="exceeds the maximum 16"):
+    with pytest.raises(halsdk.HalError, match="Requested size 17 exceeds max size 16"):
         hal.loadrt("hclogic", "personality=17")
     assert hal.components("hclogic") == []
 
