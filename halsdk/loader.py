@@ -162,7 +162,9 @@ def _spec_kind(spec_type: Any) -> str:
 def _convert(comp: str, pname: str, kind: str, raw: Any) -> Any:
     if kind.isupper():
         if isinstance(raw, str):
-            parts = [p for p in raw.split(",")]
+            parts = raw.split(",")
+            if kind in "IL":        # as the reference reads 'cfg=3,,5'
+                parts = [p if p.strip() else "0" for p in parts]
         elif isinstance(raw, (list, tuple)):
             parts = list(raw)
         else:

@@ -73,6 +73,10 @@ def make(name: str) -> int:
                 print(f"{name}: the reference did not finish in {TIMEOUT} s"
                       " (no golden written)", file=sys.stderr)
                 return 1
+    if "Realtime already running" in proc.stderr:
+        print(f"{name}: another reference HAL is running (someone did not "
+              "take the lock); no golden written", file=sys.stderr)
+        return 1
     (HERE / f"{name}.out").write_text(proc.stdout)
     err = "".join(line for line in proc.stderr.splitlines(True)
                   if line.rstrip("\n") != NOTE)
