@@ -92,3 +92,54 @@ def test_matches_reference(hal_file: Path, tmp_path: Path):
                 f"the reference's message {line!r} is missing:\n{proc.stderr}"
     left = [n for n in os.listdir("/dev/shm") if env["HALSDK_INSTANCE"] in n]
     assert left == []
+
+
+# ------------------------------------------- the library, name by name
+
+#: the components issue 5 requires, by group
+REQUIRED = {
+    "logic": "and2 or2 xor2 not logic lut5 maj3 match8 mux2 mux4 mux8 mux16 "
+             "mux_generic select8 demux edge flipflop oneshot toggle "
+             "toggle2nist debounce dbounce timedelay tof ton multiclick "
+             "multiswitch estop_latch tristate_bit tristate_float bitslice "
+             "bitwise bin2gray gray2bin",
+    "math": "abs abs_s32 sum2 scale mult2 div2 invert ddt integ lowpass "
+            "ilowpass biquad limit1 limit2 limit3 hypot near comp wcomp "
+            "deadzone minmax sample_hold offset weighted_sum scaled_s32_sums "
+            "lincurve modmath updown counter blend knob2float constant "
+            "clarke2 clarke3 clarkeinv",
+    "conversion": "conv_bit_float conv_bit_s32 conv_bit_u32 conv_float_s32 "
+                  "conv_float_u32 conv_s32_bit conv_s32_float conv_s32_u32 "
+                  "conv_u32_bit conv_u32_float conv_u32_s32",
+    "motor": "siggen pwmgen stepgen encoder encoder_ratio pid charge_pump "
+             "sim_encoder sim_home_switch sim_spindle sim_axis_hardware "
+             "watchdog",
+    "timing": "threadtest time timedelta latencybins",
+}
+ALL_REQUIRED = sorted(n for group in REQUIRED.values() for n in group.split())
+#: the load line of a first load, where the default load is refused
+LOAD_ARGS = {
+    "mux_generic": "config=bb4", "stepgen": "step_type=0",
+    "pwmgen": "output_type=0", "modmath": "mod_dir=1", "debounce": "cfg=1",
+    "weighted_sum": "wsum_sizes=1",
+}
+COMPONENTS = Path(__file__).parent.parent / "components"
+
+
+def _cases_of(name: str) -> list[Path]:
+    return [p for p in CASES
+            if p.stem == name or p.stem.startswith(name + "-")]
+
+
+@pytest.mark.parametrize("name", ALL_REQUIRED)
+def test_required_component_is_shipped(name: str, hal):
+    """A .comp source, an installed module that loads by name, and at
+    least one differential test."""
+    assert (COMPONENTS / f"{name}.comp").is_file(), f"no {name}.comp"
+    hal.loadrt(name, LOAD_ARGS.get(name, ""))
+    made = hal.components(name)
+    assert made and made[0].ready
+    assert hal.pins() or hal.functions()
+    hal.unloadrt(name)
+    assert hal.components(name) == []
+    assert _cases_of(name), f"no differential test for {name}"
