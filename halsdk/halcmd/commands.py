@@ -519,7 +519,7 @@ class Executor:
 
     def cmd_sets(self, args: list[str]) -> None:
         sig = self._signal(args[0])
-        if sig.writers or sig.bidirs:
+        if sig.writers:             # io pins do not count, as in the reference
             raise CommandError(f"signal '{args[0]}' already has writer(s)")
         try:
             value = parse_value(sig.type, args[1])
