@@ -121,7 +121,7 @@ ALL_REQUIRED = sorted(n for group in REQUIRED.values() for n in group.split())
 LOAD_ARGS = {
     "mux_generic": "config=bb4", "stepgen": "step_type=0",
     "pwmgen": "output_type=0", "modmath": "mod_dir=1", "debounce": "cfg=1",
-    "weighted_sum": "wsum_sizes=1",
+    "weighted_sum": "wsum_sizes=1", "watchdog": "num_inputs=1",
 }
 COMPONENTS = Path(__file__).parent.parent / "components"
 
