@@ -122,10 +122,15 @@ def import_component(name: str) -> ModuleType:
     for package in ("halsdk.components", "halsdk.drivers"):
         qual = f"{package}.{name}"
         try:
-            if importlib.util.find_spec(qual) is None:
-                continue
+            spec = importlib.util.find_spec(qual)
         except ModuleNotFoundError:
             continue
+        if spec is None:
+            continue
+        origin = spec.origin or ""
+        if origin.endswith(tuple(importlib.machinery.EXTENSION_SUFFIXES)):
+            # compiled: each load gets fresh statics, as from a folder
+            return _import_file(name, origin)
         try:
             return importlib.import_module(qual)
         except Exception as exc:
