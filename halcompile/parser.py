@@ -299,11 +299,6 @@ class _Parser:
         if item.array is not None and len(re.findall("#+", name)) > 1:
             raise self.error(f"array '{name}' has more than one run of '#'",
                              npos)
-        if item.array is not None:
-            digits = max(len(r) for r in re.findall("#+", name))
-            if item.array.size > 10 ** digits:
-                raise self.error(f"array '{name}' has {item.array.size} items"
-                                 f": more than {digits} '#' can number", npos)
         if self.at_word("if"):
             self.pos += 2
             item.condition, cpos = self.raw_until("=;", "a condition")

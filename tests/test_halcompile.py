@@ -529,7 +529,6 @@ PIN = "pin in bit the_pin;\n"
      "duplicate item name 'a'"),
     ("pin out float a-#;\n", "x.comp:4:15", "not an array"),
     ("pin out float a[2];\n", "x.comp:4:15", "has no '#'"),
-    ("pin out float a#[11];\n", "x.comp:4:15", "more than 1 '#'"),
     ("pin out float a#[0];\n", "x.comp:4:15", "at least one item"),
     ("pin up float a;\n", "x.comp:4:5", "expected a pin direction"),
     ("param rw bits a;\n", "x.comp:4:10", "expected a HAL type"),
@@ -680,3 +679,13 @@ def test_install_then_halrun_from_a_fresh_account(tmp_path):
     assert any(line.split()[-1:] == ["d.out"] and "42.5" in line
                for line in lines[2:])
     assert (home / ".cache" / "halsdk" / "build").is_dir()
+
+
+def test_hash_run_is_a_minimum_width():
+    """As in the reference, '#' is a minimum width: a#[12] numbers its
+    pins a0 ... a9, a10, a11 (a .comp that relies on it compiles)."""
+    comp = parse("component x;\npin out float a#[12];\nfunction _;\n"
+                 'license "GPL";\n;;\n', "x.comp")
+    assert comp.pins[0].array.size == 12
+    assert hal_format(comp.pins[0].name) == "a%01d"
+    assert hal_format(comp.pins[0].name) % 11 == "a11"
