@@ -47,10 +47,25 @@ min-speed-estimate seconds without a count (the time of one count at
 min-speed-estimate only when position-scale is 1; with a negative
 position-scale, at the first period without a count).
 
-missing-teeth: a tooth that comes more than (missing-teeth + 2) / 2 times
-the previous tooth interval after the previous tooth is taken as the one
-after the gap and counts missing-teeth + 1.  The reference's detection
-differs in some cases (see the differential tests, which do not cover it).
+\\fBmissing-teeth\\fR (as in the reference): for a toothed wheel with a gap
+of missing-teeth teeth, such as a 60-2 crank wheel.  Each count up that
+comes at least a limit after the previous count is taken as the tooth
+after the gap: it counts missing-teeth + 1 and, with index-enable set,
+is the index (counts 0 at that tooth).  The limit is learnt from the
+teeth themselves: each count up moves it a tenth of the way towards
+missing-teeth + 1/2 times the interval per count (the interval divided
+by missing-teeth + 1 after a gap), except the first two counts after
+loading, which are not used.  It starts at zero, so at first every tooth
+counts missing-teeth + 1; on a wheel turning at a steady speed it takes
+two or three turns before only the gap does (with missing-teeth 1 and
+teeth that are not evenly spaced it may never happen: keep index-enable
+clear and check the count until it has settled).  Once settled,
+an interval longer than about missing-teeth + 1/2 teeth is a gap, so a
+sudden slowdown by that factor is taken as one too.  A count down (in quadrature mode) moves the limit a tenth of the
+way towards zero.  The same rule applies to the counts up in quadrature
+mode, where it is rarely useful (there our counts match the reference's
+for steady rates and simple reversals, not in every case).  With
+missing-teeth 0 nothing is added but the limit is still learnt.
 
 The pins x4-mode, counter-mode, position-scale and index-enable are
 I/O pins: they can be linked to a signal with other I/O pins or set
@@ -84,7 +99,7 @@ pin io float position_scale = 1.0 "Counts per machine unit (may be negative to r
 pin io bit x4_mode = 1 "True: count every edge of A and B (4 counts per cycle); false: one count per cycle.  Ignored in counter mode.";
 pin io bit counter_mode "True: count the rising edges of phase-A only, up, ignoring phase-B.";
 pin in float min_speed_estimate = 1.0 "Lowest speed (in units per second) that gives a non-zero velocity; a lower value makes the velocity take longer to fall to 0 after the counts stop.";
-pin in s32 missing_teeth "In counter mode: the number of teeth missing from the gap of a toothed index wheel; the gap then counts as that many teeth plus one.  0: no gap.";
+pin in s32 missing_teeth "For a toothed wheel with a gap used as the index: the number of teeth missing from the gap (e.g. 2 for a 60-2 wheel, with position-scale 60).  A long enough interval then counts this many teeth plus one.  0: off.  See NOTES.";
 
 variable int ab;
 variable int zold;
@@ -92,11 +107,13 @@ variable int lold;
 variable int raw;
 variable int idx_raw;
 variable int idx_seen;
+variable int armed;
 variable int latch_raw;
 variable int latch_seen;
 variable long long stamp;
 variable long long tooth_t;
-variable long long tooth_dt;
+variable long long tooth_lim;
+variable int teeth_seen;
 
 variable int old_raw;
 variable int offset;
@@ -154,25 +171,39 @@ static void update_counters(void *arg, long period)
     FOR_ALL_INSTS() {
         int n = (phase_A ? 1 : 0) | (phase_B ? 2 : 0);
         int o = ab;
-        int d;
+        int d, gap;
 
-        if (counter_mode) {
+        if (counter_mode)
             d = (n & 1) && !(o & 1);
-            if (d && missing_teeth > 0) {
-                /* a tooth interval well over the last normal one (more
-                   than halfway to the length of the gap) is the gap */
-                long long dt = timebase - tooth_t;
-
-                tooth_t = timebase;
-                if (tooth_dt && dt * 2 > tooth_dt * (missing_teeth + 2))
-                    d += missing_teeth;
-                else
-                    tooth_dt = dt;
-            }
-        } else if (x4_mode) {
+        else if (x4_mode)
             d = step4[(o << 2) | n];
-        } else {
+        else
             d = step1[(o << 2) | n];
+
+        /* missing-teeth: a count up that comes at least tooth_lim after
+           the previous count is taken as the gap and adds missing-teeth */
+        gap = 0;
+        if (d) {
+            long long dt = timebase - tooth_t;
+
+            tooth_t = timebase;
+            if (d > 0 && dt >= tooth_lim) {
+                gap = 1;
+                d += missing_teeth;
+            }
+            /* the limit follows missing-teeth + 1/2 times the time per
+               count, smoothed with a weight of 1/10; the first two counts
+               are not used, a net count down pulls it towards zero and
+               a gap that leaves no count does not change it */
+            if (teeth_seen < 2) {
+                teeth_seen++;
+            } else if (d > 0) {
+                long long lim = dt * (2LL * missing_teeth + 1) / (2LL * d);
+
+                tooth_lim += (lim - tooth_lim) / 10;
+            } else if (d < 0) {
+                tooth_lim -= tooth_lim / 10;
+            }
         }
         ab = n;
         if (d) {
@@ -180,9 +211,10 @@ static void update_counters(void *arg, long period)
             stamp = timebase;
         }
 
-        if (phase_Z && !zold && index_enable) {
+        if (((phase_Z && !zold) || (gap && missing_teeth)) && armed) {
             idx_raw = raw;
             idx_seen = 1;
+            armed = 0;
         }
         zold = phase_Z;
 
@@ -221,6 +253,9 @@ static void capture_position(void *arg, long period)
             offset = idx_raw;
             index_enable = 0;
         }
+        /* update-counters looks for the index only once this function
+           has seen index-enable set */
+        armed = index_enable;
         if (latch_seen) {
             latch_seen = 0;
             counts_latched = latch_raw - offset;

@@ -275,16 +275,78 @@ def test_encoder_ratio_zero_ppr_gives_zero_error(hal):
     assert not tr["g.error"].any()
 
 
-def test_encoder_missing_teeth_gap_counts_as_the_missing_teeth(hal):
-    encoder_setup(hal, **{"counter-mode": True, "missing-teeth": 1})
-    # teeth every 4 periods; after the 5th tooth one tooth is missing
-    a = []
-    for tooth in range(10):
-        a += [1, 1, 0, 0] + ([0, 0, 0, 0] if tooth == 4 else [])
-    a = np.array(a, dtype=bool)
+def tooth_train(intervals, lead=10):
+    """phase-A for teeth one period wide; intervals[k] periods from tooth k
+    to tooth k + 1 (the first tooth comes after lead periods)."""
+    a = [0] * lead
+    for n in intervals:
+        a += [1] + [0] * (n - 1)
+    return np.array(a, dtype=bool)
+
+
+def tooth_counts(hal, a, **pins):
+    """count added by each tooth (rising edge of phase-A)."""
+    encoder_setup(hal, **{"counter-mode": True, **pins})
     tr = hal.run(len(a), inputs={"encoder.0.phase-A": a},
-                 record=["encoder.0.counts"])
-    got = tr["encoder.0.counts"]
-    assert got[16] == 5          # the 5th tooth
-    assert got[24] == 7          # the tooth after the gap counts 2
-    assert got[-1] == 11
+                 record=["encoder.0.rawcounts", "encoder.0.counts",
+                         "encoder.0.index-enable"])
+    raw = tr["encoder.0.rawcounts"]
+    rises = np.flatnonzero(a & ~np.concatenate(([False], a[:-1])))
+    steps = [int(raw[k] - (raw[k - 1] if k else 0)) for k in rises]
+    return steps, tr
+
+
+def test_encoder_missing_teeth_first_teeth_all_count_as_the_gap(hal):
+    # the limit starts at zero, so until it has been learnt every tooth
+    # counts missing-teeth + 1
+    steps, _ = tooth_counts(hal, tooth_train([6] * 8), **{"missing-teeth": 2})
+    assert steps == [3] * 8
+
+
+def test_encoder_missing_teeth_locks_on_a_toothed_wheel(hal):
+    # 12-tooth wheel with 2 teeth missing: 9 intervals of 6 periods and a
+    # gap of 18; after about three turns only the tooth after the gap
+    # counts 3
+    wheel = [6] * 9 + [18]
+    steps, _ = tooth_counts(hal, tooth_train(wheel * 6), **{"missing-teeth": 2})
+    assert steps[:30] == [3] * 30
+    assert steps[-20:] == ([3] + [1] * 9) * 2
+    assert sum(steps[-10:]) == 12     # one turn counts all 12 teeth
+
+
+def test_encoder_missing_teeth_limit_is_missing_teeth_and_a_half_teeth(hal):
+    # once locked on teeth 4 periods apart, with missing-teeth 1 an
+    # interval of 6 (1.5 teeth) is a gap, one of 5 is not
+    head = [6] * 30 + [4] * 10
+    steps, _ = tooth_counts(hal, tooth_train(head + [5] + [4] * 3),
+                            **{"missing-teeth": 1})
+    assert steps[31:41] == [1] * 10
+    assert steps[41] == 1
+
+
+def test_encoder_missing_teeth_long_interval_after_lock_is_a_gap(hal):
+    head = [6] * 30 + [4] * 10
+    steps, _ = tooth_counts(hal, tooth_train(head + [6] + [4] * 3),
+                            **{"missing-teeth": 1})
+    assert steps[31:41] == [1] * 10
+    assert steps[41] == 2
+    assert steps[42] == 1
+
+
+def test_encoder_missing_teeth_gap_is_the_index(hal):
+    # with index-enable set the first gap makes the tooth after it zero
+    a = tooth_train([6] * 4)
+    steps, tr = tooth_counts(hal, a, **{"missing-teeth": 2,
+                                        "index-enable": True})
+    first = int(np.flatnonzero(a)[0])
+    assert tr["encoder.0.rawcounts"][first] == 3
+    assert tr["encoder.0.counts"][first] == 0
+    assert not tr["encoder.0.index-enable"][first]
+    assert tr["encoder.0.counts"][-1] == 9
+
+
+def test_encoder_missing_teeth_zero_counts_each_tooth_once(hal):
+    steps, tr = tooth_counts(hal, tooth_train([6] * 5 + [18] + [6] * 4),
+                             **{"index-enable": True})
+    assert steps == [1] * 10
+    assert tr["encoder.0.index-enable"][-1]
