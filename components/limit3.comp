@@ -85,9 +85,12 @@ FUNCTION(_) {
     /* land on the goal when it is in reach and the speed change needed
        afterwards (to the goal's speed) is no larger than this one */
     need = (goal - out) / dt;
-    if (need >= vlo && need <= vhi && fabs(gvel - need) <= fabs(need - vel)) {
+    if ((need >= vlo && need <= vhi && fabs(gvel - need) <= fabs(need - vel))
+        || (fabs(need) < 1e-9 && fabs(vel) < 1e-9)) {
+        /* (the second test ends the endless halving of the last
+           smoothed steps once out is within rounding of the goal) */
+        vel = need;
         out = goal;
-        vel = gvel;
         return;
     }
 
@@ -113,13 +116,17 @@ FUNCTION(_) {
         if (smooth_steps >= 2 && rel != 0 && gap * rel > 0) {
             double t = 2 * gap / (rel * dt);   /* periods to close the gap */
 
-            if (t < smooth_steps - 1e-9) {      /* not on a tie */
+            if (t < smooth_steps) {     /* an exact tie brakes fully */
                 double k = ceil(t);
 
-                nv = gv + rel * (k - 1) / k;
+                /* unless that would brake harder than maxa anyway */
+                if (fabs(rel / (k * dt)) < maxa)
+                    nv = gv + rel * (k - 1) / k;
             }
         }
     }
-    vel = nv;
-    out += nv * dt;
+    /* the speed kept is the one out really moved at, rounding included */
+    nv = out + nv * dt;
+    vel = (nv - out) / dt;
+    out = nv;
 }

@@ -298,8 +298,21 @@ def test_limit3_trapezoid_lands_exactly(hal):
     assert np.all(np.abs(v) <= 100.0 + 1e-9)
     assert np.all(np.abs(a) <= 10000.0 + 1e-6)
     assert v[:10] == pytest.approx(np.arange(1, 11) * 10.0)  # full accel
-    assert x[-1] == 5.0 and np.all(x <= 5.0)                # no overshoot
+    assert x[-1] == 5.0 and np.all(x <= 5.0 + 1e-12)        # no overshoot
     assert np.count_nonzero(np.abs(v - 100.0) < 1e-9) >= 30  # cruise
+
+
+def test_limit3_last_steps_halve_then_land(hal):
+    """From one period of braking left (0.5 units/s, 0.5 mm to go), the
+    default smoothing halves the speed each period, then out lands on the
+    goal exactly once within rounding of it."""
+    setup(hal, "limit3")
+    hal.set({"limit3.0.maxv": 50.0, "limit3.0.maxa": 500.0,
+             "limit3.0.in": 1.0})
+    x = run(hal, 130, {}, ["limit3.0.out"])["limit3.0.out"]
+    v = np.diff(x) / 1e-3
+    assert v[88] == pytest.approx(0.25) and v[89] == pytest.approx(0.125)
+    assert x[-1] == 1.0 and 1.0 - x[110] > 0
 
 
 @pytest.mark.parametrize("smooth", [0, 1, 2, 3, 5])
