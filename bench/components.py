@@ -248,7 +248,7 @@ LOCK = "/tmp/halsdk-reference.lock"
 
 
 def fmt(v: Optional[float]) -> str:
-    return "-" if v is None else f"{v:.0f}"
+    return "-" if v is None else f"{v:.1f}"
 
 
 def ratio(a: Optional[float], b: Optional[float]) -> str:

@@ -176,6 +176,7 @@ typedef struct {
     unsigned long t_rev;    /* ns until motion may restart the other way */
     int dir;                /* +1 forward, -1 reverse */
     int held;               /* waiting for t_rev before reversing */
+    int step_on, dir_on;    /* step type 0: what step and dir show */
     int type;
     int state;              /* index in the pattern (types 2 and up) */
     int nstates;
@@ -231,14 +232,17 @@ static void make_pulses(void *arg, long period)
         long long acc;
         int stepped;
 
-        tick(&c->t_pulse, period);
-        tick(&c->t_dir, period);
-        tick(&c->t_rev, period);
+        /* t_rev >= t_dir >= t_pulse always: all three are 0 at once */
+        if (c->t_rev) {
+            tick(&c->t_pulse, period);
+            tick(&c->t_dir, period);
+            tick(&c->t_rev, period);
+        }
         if (!*c->en) {
             /* let a pulse in progress finish */
             if (c->t_pulse == 0) {
                 if (c->type == 0)
-                    *c->out[0] = 0;
+                    *c->out[0] = c->step_on = 0;
                 else if (c->type == 1)
                     *c->out[0] = *c->out[1] = 0;
             }
@@ -250,7 +254,7 @@ static void make_pulses(void *arg, long period)
         if (c->held && c->t_rev == 0)
             c->held = 0;
         /* ramp the add value; it stays put while a reversal waits */
-        if (!c->held) {
+        if (!c->held && c->add != c->add_goal) {
             add = c->add_goal;
             if (c->add_slew != 0) {
                 if (add > c->add + c->add_slew)
@@ -269,10 +273,12 @@ static void make_pulses(void *arg, long period)
                 c->dir = -c->dir;
         }
         if (c->type == 0) {
-            if (c->t_dir == 0 && add != 0)
-                *c->out[1] = add < 0;
-            if (c->t_pulse == 0)
-                *c->out[0] = 0;
+            /* the outputs are written when they change: fewer stores to
+               shared memory in the common case of nothing to do */
+            if (c->t_dir == 0 && add != 0 && (add < 0) != c->dir_on)
+                *c->out[1] = c->dir_on = add < 0;
+            if (c->t_pulse == 0 && c->step_on)
+                *c->out[0] = c->step_on = 0;
         } else if (c->type == 1) {
             if (c->t_pulse == 0)
                 *c->out[0] = *c->out[1] = 0;
@@ -289,7 +295,7 @@ static void make_pulses(void *arg, long period)
             c->t_dir = c->steplen + c->hold_ns;
             c->t_rev = c->t_dir + c->dirsetup;
             if (c->type == 0) {
-                *c->out[0] = 1;
+                *c->out[0] = c->step_on = 1;
             } else if (c->type == 1) {
                 *c->out[c->dir > 0 ? 0 : 1] = 1;
             } else if (c->nstates > 0) {
