@@ -30,6 +30,7 @@ from pathlib import Path
 
 import pytest
 from test_halcmd import normalize
+from test_halcmd_corpus import _env
 
 COMPLIB = Path(__file__).parent / "complib"
 GOLDEN = (".out", ".err", ".rc")
@@ -39,21 +40,6 @@ CASES = sorted(p for p in COMPLIB.glob("*.hal")
 _MACHINERY = re.compile(
     r"waitpid failed|exited without becoming ready|: rtapi_app_main: |"
     r"^HAL: ERROR: |^Note: Using POSIX non-realtime$")
-TOOLS = ("halsampler", "halstreamer")
-
-
-def _env(name: str, tools: Path) -> dict:
-    env = dict(os.environ)
-    env["HALSDK_INSTANCE"] = f"cl-{os.getpid()}-{name}"
-    if not all(shutil.which(t) for t in TOOLS):
-        tools.mkdir(exist_ok=True)
-        for tool in TOOLS:
-            script = tools / tool
-            script.write_text(f'#!/bin/sh\nexec "{sys.executable}" -m '
-                              f'halsdk.tools.{tool} "$@"\n')
-            script.chmod(0o755)
-        env["PATH"] = f"{tools}{os.pathsep}{env.get('PATH', '')}"
-    return env
 
 
 def _inputs(name: str) -> list[Path]:

@@ -8,19 +8,10 @@ import math
 
 import numpy as np
 import pytest
+from test_lib_extra import setup
 
 import halsdk
 from halsdk import _core
-
-PERIOD = 1_000_000
-
-
-def setup(hal, comp, *funct, args=()):
-    hal.loadrt(comp, *args)
-    hal.newthread("t", PERIOD)
-    for f in funct:
-        hal.addf(f, "t")
-
 
 # feedcomp ----------------------------------------------------------------
 
