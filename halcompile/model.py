@@ -57,8 +57,22 @@ class Array:
     condsize_loc: Optional[Loc] = None
 
 
+class _Named:
+    """The C and HAL names of an item declared with a .comp name."""
+
+    name: str
+
+    @property
+    def c_name(self) -> str:
+        return c_identifier(self.name)
+
+    @property
+    def hal_name(self) -> str:
+        return hal_identifier(self.name)
+
+
 @dataclass
-class Pin:
+class Pin(_Named):
     """A pin (``kind == "pin"``) or a parameter (``kind == "param"``)."""
 
     kind: str
@@ -73,29 +87,13 @@ class Pin:
     condition_loc: Optional[Loc] = None
     default_loc: Optional[Loc] = None
 
-    @property
-    def c_name(self) -> str:
-        return c_identifier(self.name)
-
-    @property
-    def hal_name(self) -> str:
-        return hal_identifier(self.name)
-
 
 @dataclass
-class Function:
+class Function(_Named):
     name: str
     loc: Loc
     fp: bool = True
     doc: Optional[str] = None
-
-    @property
-    def c_name(self) -> str:
-        return c_identifier(self.name)
-
-    @property
-    def hal_name(self) -> str:
-        return hal_identifier(self.name)
 
 
 @dataclass

@@ -4,10 +4,9 @@ compiled into modules, loaded with loadrt and stepped."""
 from __future__ import annotations
 
 import os
-import subprocess
-import sys
 
 import pytest
+from test_halcompile import halcompile
 
 from halcompile import CompError, parse
 from halcompile.gen_cython import CythonSourceError, generate, split_code
@@ -17,17 +16,6 @@ from halsdk.errors import InvalidError
 HERE = os.path.dirname(os.path.abspath(__file__))
 COMPS = os.path.join(HERE, "comps")
 PERIOD = 1_000_000
-
-
-def halcompile(*args: str, cwd: str) -> subprocess.CompletedProcess:
-    env = dict(os.environ)
-    import halcompile as hc
-    import halsdk
-    dirs = {os.path.dirname(os.path.dirname(m.__file__)) for m in (hc, halsdk)}
-    env["PYTHONPATH"] = os.pathsep.join([*sorted(dirs),
-                                         env.get("PYTHONPATH", "")])
-    return subprocess.run([sys.executable, "-m", "halcompile", *args],
-                          cwd=cwd, env=env, capture_output=True, text=True)
 
 
 @pytest.fixture(scope="module")
