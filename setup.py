@@ -36,6 +36,8 @@ core = Extension(
         "halsdk/src/hal_thread.c",
         "halsdk/src/hal_api.c",
         "halsdk/src/hal_stream.c",
+        "halsdk/src/hal_shmem.c",
+        "halsdk/src/hal_symbol.c",
     ],
     include_dirs=["halsdk/include", "halsdk/src"],
     extra_compile_args=FLAGS,

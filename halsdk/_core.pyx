@@ -198,6 +198,11 @@ cdef extern from "hal_core.h" nogil:
     long long hal_stream_create(const char *name, int owner_id, int depth,
                                 const char *typestring)
     long long hal_stream_attach(const char *name)
+    long long hal_shmem_attach(const char *name)
+    void *hal_shmem_ptr(long long handle)
+    long hal_shmem_size(long long handle)
+    void *hal_symbol_find(const char *name, const char *user)
+    const char *hal_symbol_user(const char *module)
     hal_stream_t *hal_stream_get(long long handle)
     int hal_stream_write(long long handle, const halsdk_value_t *rec)
     int hal_stream_read(long long handle, halsdk_value_t *rec,
@@ -1476,6 +1481,32 @@ def stream_create(name, int owner_id, int depth, typestring) -> Stream:
     if h < 0:
         check(<int>h)
     return stream_attach(name)
+
+
+def shmem_attach(name) -> tuple:
+    """``(address, size)`` in this process of the named shared block a
+    realtime module made (NotFoundError if there is none).  The address
+    stays valid while the block's owner is loaded."""
+    need_instance()
+    cdef bytes b = enc(name)
+    cdef long long h = hal_shmem_attach(b)
+    if h < 0:
+        check(<int>h)
+    return <size_t>hal_shmem_ptr(h), hal_shmem_size(h)
+
+
+def symbol_address(name) -> int:
+    """Address of a symbol a loaded realtime module exported
+    (EXPORT_SYMBOL), or 0.  For tests that call it with ctypes."""
+    cdef bytes b = enc(name)
+    return <size_t>hal_symbol_find(b, NULL)
+
+
+def symbol_user(module):
+    """A loaded module that uses symbols of ``module``, or None."""
+    cdef bytes b = enc(module)
+    cdef const char *u = hal_symbol_user(b)
+    return None if u == NULL else u.decode()
 
 
 def stream_attach(name) -> Stream:

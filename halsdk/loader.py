@@ -40,7 +40,14 @@ from types import ModuleType
 from typing import Any, Optional
 
 from halsdk import _core
-from halsdk.errors import ExistsError, HalError, InvalidError, LoadError, NotFoundError
+from halsdk.errors import (
+    ConflictError,
+    ExistsError,
+    HalError,
+    InvalidError,
+    LoadError,
+    NotFoundError,
+)
 
 _MODULE_NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 _KINDS = {int: "i", float: "f", str: "s"}
@@ -302,9 +309,14 @@ class Registry:
                 _core.comp_exit(cid)
 
     def unload(self, name: str) -> None:
-        loaded = self.modules.pop(name, None)
+        loaded = self.modules.get(name)
         if loaded is None:
             raise NotFoundError(f"module '{name}' is not loaded")
+        user = _core.symbol_user(name)
+        if user is not None and user in self.modules:
+            raise ConflictError(f"{name}: module '{user}' uses it; unload "
+                                f"'{user}' first")
+        del self.modules[name]
         self._undo(loaded.module, loaded.comp_ids)
 
     def unload_all(self) -> None:

@@ -21,7 +21,7 @@
 extern "C" {
 #endif
 
-#define HALSDK_API_VERSION 3
+#define HALSDK_API_VERSION 4
 #define HALSDK_CAPSULE_NAME "halsdk._core._C_API"
 
 /* longest object name, not counting the terminating NUL */
@@ -134,6 +134,22 @@ typedef struct halsdk_api {
        returns the text kept */
     void (*msg_capture)(int on);
     const char *(*captured_msgs)(void);
+
+    /* --- version 4: named shared blocks and exported symbols --- */
+    /* a block of size bytes (zeroed, 64-byte aligned) in the instance,
+       found by name from any attached process and removed with its
+       owner; handles are >= 0, errors -errno */
+    long long (*shmem_new)(const char *name, int owner_id, long size);
+    long long (*shmem_attach)(const char *name);
+    void *(*shmem_ptr)(long long handle);       /* NULL: stale handle */
+    long (*shmem_size)(long long handle);
+    /* symbols that one realtime module offers to others in the host
+       process (EXPORT_SYMBOL); find records the module that uses it,
+       so that the exporter cannot be unloaded first */
+    int (*symbol_export)(const char *name, void *addr, const char *module);
+    void *(*symbol_find)(const char *name, const char *user_module);
+    void (*symbol_drop)(const char *module);
+    const char *(*symbol_user)(const char *module);
 } halsdk_api;
 
 #ifdef __cplusplus

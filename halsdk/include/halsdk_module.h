@@ -26,6 +26,16 @@ __attribute__((visibility("hidden")))
 void halsdk_modparam_register(const char *name, char kind, void *addr,
                               int count, const char *desc);
 
+/* EXPORT_SYMBOL: the table of symbols the module offers other modules,
+   filled by constructors like the modparams and exported by the module
+   entry when the module loads */
+__attribute__((visibility("hidden")))
+void halsdk_symbol_register(const char *name, void *addr);
+
+/* the module's name (HALSDK_MODULE_NAME), defined by the module entry */
+__attribute__((visibility("hidden")))
+extern const char halsdk_module_name[];
+
 #ifdef __cplusplus
 }
 #endif

@@ -40,8 +40,19 @@ void rtapi_app_exit(void);
 #define MODULE_DESCRIPTION(s) \
     __attribute__((used)) static const char halsdk_description[] = s
 #define MODULE_INFO(tag, s)
-#define EXPORT_SYMBOL(sym)
-#define EXPORT_SYMBOL_GPL(sym)
+/* offer sym (a function or variable of this module) to the modules
+   loaded after it; they find it with halsdk_symbol_find("sym") */
+#define EXPORT_SYMBOL(sym)                                                 \
+    static void __attribute__((constructor)) halsdk_sym_reg_##sym(void)    \
+    {                                                                      \
+        halsdk_symbol_register(#sym, (void *)&(sym));                      \
+    }
+#define EXPORT_SYMBOL_GPL(sym) EXPORT_SYMBOL(sym)
+
+/* the address a loaded module exported as name, or NULL; records that
+   this module uses that one (which then cannot be unloaded first) */
+#define halsdk_symbol_find(name) \
+    (HALSDK_API->symbol_find((name), halsdk_module_name))
 
 #ifdef __cplusplus
 }

@@ -28,6 +28,43 @@ const halsdk_api *halsdk_api_ptr;
 #define STR2_(a) #a
 #define STR_(a) STR2_(a)
 
+const char halsdk_module_name[] = STR_(HALSDK_MODULE_NAME);
+
+/* EXPORT_SYMBOL entries of the module */
+#define MAX_EXPORTS 64
+static struct {
+    const char *name;
+    void *addr;
+} exports[MAX_EXPORTS];
+static int nexports;
+static int export_overflow;
+
+void halsdk_symbol_register(const char *name, void *addr)
+{
+    if (nexports >= MAX_EXPORTS) {
+        export_overflow = 1;
+        return;
+    }
+    exports[nexports].name = name;
+    exports[nexports].addr = addr;
+    nexports++;
+}
+
+/* offer the module's symbols; on a failure none stays exported */
+static int export_symbols(void)
+{
+    for (int i = 0; i < nexports; i++) {
+        int r = halsdk_api_ptr->symbol_export(exports[i].name,
+                                              exports[i].addr,
+                                              halsdk_module_name);
+        if (r < 0) {
+            halsdk_api_ptr->symbol_drop(halsdk_module_name);
+            return r;
+        }
+    }
+    return 0;
+}
+
 static halsdk_modparam_t modparams[HALSDK_MAX_MODPARAMS];
 static void *defaults[HALSDK_MAX_MODPARAMS];    /* values at import */
 static int nmodparams;
@@ -284,7 +321,12 @@ static PyObject *mod_setup(PyObject *self, PyObject *args, PyObject *kw)
 #else
     Py_BEGIN_ALLOW_THREADS
     halsdk_api_ptr->msg_capture(1);
-    r = rtapi_app_main();
+    r = export_symbols();
+    if (r == 0) {
+        r = rtapi_app_main();
+        if (r != 0)
+            halsdk_api_ptr->symbol_drop(halsdk_module_name);
+    }
     halsdk_api_ptr->msg_capture(0);
     Py_END_ALLOW_THREADS
     const char *msgs = halsdk_api_ptr->captured_msgs();
@@ -304,6 +346,7 @@ static PyObject *mod_cleanup(PyObject *self, PyObject *unused)
         rtapi_app_exit();
         Py_END_ALLOW_THREADS
     }
+    halsdk_api_ptr->symbol_drop(halsdk_module_name);
     Py_RETURN_NONE;
 }
 
@@ -325,6 +368,11 @@ PyMODINIT_FUNC CAT_(PyInit_, HALSDK_MODULE_NAME)(void)
 {
     if (import_halsdk() < 0)
         return NULL;
+    if (export_overflow) {
+        PyErr_Format(PyExc_ImportError, "%s exports more than %d symbols",
+                     STR_(HALSDK_MODULE_NAME), MAX_EXPORTS);
+        return NULL;
+    }
     if (mp_overflow) {
         PyErr_Format(PyExc_ImportError, "%s declares more than %d module "
                      "parameters", STR_(HALSDK_MODULE_NAME),

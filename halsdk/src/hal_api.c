@@ -175,4 +175,12 @@ const halsdk_api halsdk_api_table = {
     .stream_elem_type = hal_stream_elem_type,
     .msg_capture = api_msg_capture,
     .captured_msgs = api_captured_msgs,
+    .shmem_new = hal_shmem_new,
+    .shmem_attach = hal_shmem_attach,
+    .shmem_ptr = hal_shmem_ptr,
+    .shmem_size = hal_shmem_size,
+    .symbol_export = hal_symbol_export,
+    .symbol_find = hal_symbol_find,
+    .symbol_drop = hal_symbol_drop,
+    .symbol_user = hal_symbol_user,
 };

@@ -45,7 +45,7 @@ static const char *kind_word(int kind)
 {
     static const char *const words[K_NKINDS] = {
         "object", "component", "instance", "pin", "param", "signal",
-        "function", "thread", "stream"
+        "function", "thread", "stream", "shared block"
     };
     return kind > 0 && kind < K_NKINDS ? words[kind] : "object";
 }
@@ -1312,6 +1312,7 @@ static void delete_items_of(hoff_t comp, hoff_t inst)
         if (it->comp == comp && (!inst || it->inst == inst))
             item_delete(it);
     hal_stream_delete_of(comp, inst);
+    hal_shmem_delete_of(comp, inst);
 }
 
 int hal_inst_delete(const char *name)

@@ -20,7 +20,7 @@
 #include <sys/types.h>
 
 #define HAL_MAGIC 0x31304b4453474c48ULL   /* "HLGSDK01" */
-#define HAL_ABI_VERSION 2
+#define HAL_ABI_VERSION 3
 #define HAL_NAME_SIZE (HALSDK_NAME_LEN + 1)
 #define HAL_DEFAULT_SIZE (160L * 1024 * 1024)
 #define HAL_MIN_SIZE (1L * 1024 * 1024)
@@ -39,7 +39,7 @@ typedef union {
 
 enum hal_kind {
     K_NONE = 0, K_COMP, K_INST, K_PIN, K_PARAM, K_SIG, K_FUNCT, K_THREAD,
-    K_STREAM,
+    K_STREAM, K_SHMEM,
     K_NKINDS
 };
 
@@ -163,6 +163,19 @@ typedef struct {
     uint64_t read_idx __attribute__((aligned(64)));
     uint64_t pad2 __attribute__((aligned(64)));
 } hal_stream_t;
+
+/*
+ * A named shared block (hal_shmem.c): size bytes at offset data (64-byte
+ * aligned) that any attached process finds by name; deleted with its
+ * owner.
+ */
+typedef struct {
+    hal_obj_t o;
+    hoff_t comp, inst;          /* owner: deleted with it */
+    hoff_t data;
+    uint32_t pad;
+    uint64_t size;
+} hal_shmem_t;
 
 /* an allocated block; the user data follows the header */
 typedef struct {
@@ -307,6 +320,19 @@ int hal_stream_nelem(long long handle);
 int hal_stream_elem_type(long long handle, int index);
 int hal_stream_parse_types(const char *typestring, uint8_t *types,
                            const char *what);
+
+/* named shared blocks (hal_shmem.c) */
+long long hal_shmem_new(const char *name, int owner_id, long size);
+long long hal_shmem_attach(const char *name);
+void *hal_shmem_ptr(long long handle);
+long hal_shmem_size(long long handle);
+void hal_shmem_delete_of(hoff_t comp, hoff_t inst);
+
+/* symbols between realtime modules (hal_symbol.c) */
+int hal_symbol_export(const char *name, void *addr, const char *module);
+void *hal_symbol_find(const char *name, const char *user);
+void hal_symbol_drop(const char *module);
+const char *hal_symbol_user(const char *module);
 
 /* values */
 hal_value_t *hal_pin_value(hal_pin_t *pin);
