@@ -19,6 +19,11 @@ import re
 from collections.abc import Iterable, Iterator
 from typing import Optional
 
+from halsdk.ini import IniFile
+
+__all__ = ["IniFile", "SubstitutionError", "logical_lines", "split_words",
+           "strip_comment", "substitute", "tokenize"]
+
 
 class SubstitutionError(Exception):
     """A ``$VAR`` or ``[SECTION]KEY`` that cannot be replaced."""
@@ -48,34 +53,6 @@ def strip_comment(line: str) -> str:
         elif ch == "#" and not quoted:
             return line[:i]
     return line
-
-
-class IniFile:
-    """The entries of an INI file, looked up as ``[SECTION]KEY``.
-
-    Like the reference, the first occurrence of a key wins and keys are
-    case sensitive.
-    """
-
-    def __init__(self, path: str):
-        self.path = path
-        self.values: dict[tuple[str, str], str] = {}
-        section = ""
-        with open(path, encoding="utf-8", errors="replace") as f:
-            for raw in f:
-                line = raw.strip()
-                if not line or line[0] in "#;":
-                    continue
-                if line.startswith("[") and "]" in line:
-                    section = line[1:line.index("]")]
-                    continue
-                if "=" in line:
-                    key, _, value = line.partition("=")
-                    self.values.setdefault((section, key.strip()),
-                                           value.strip())
-
-    def get(self, section: str, key: str) -> Optional[str]:
-        return self.values.get((section, key))
 
 
 _ENV_PAREN = re.compile(r"\$\(([^)]*)\)")

@@ -1,0 +1,62 @@
+"""INI files of machine configurations, read as the reference reads them.
+
+``[SECTION]`` headers, ``KEY = VALUE`` lines, ``#`` and ``;`` comment
+lines.  The first occurrence of a key in a section wins and keys are case
+sensitive, as in LinuxCNC.  Each entry remembers its line, so that a
+program that finds a bad value can name the file and line.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from typing import Optional
+
+
+class IniFile:
+    """The entries of an INI file, looked up as ``[SECTION]KEY``."""
+
+    def __init__(self, path: str):
+        self.path = path
+        self.values: dict[tuple[str, str], str] = {}
+        self.lines: dict[tuple[str, str], int] = {}
+        self.section_lines: dict[str, int] = {}
+        section = ""
+        with open(path, encoding="utf-8", errors="replace") as f:
+            for number, raw in enumerate(f, 1):
+                line = raw.strip()
+                if not line or line[0] in "#;":
+                    continue
+                if line.startswith("[") and "]" in line:
+                    section = line[1:line.index("]")]
+                    self.section_lines.setdefault(section, number)
+                    continue
+                if "=" in line:
+                    key, _, value = line.partition("=")
+                    where = (section, key.strip())
+                    if where not in self.values:
+                        self.values[where] = value.strip()
+                        self.lines[where] = number
+
+    def get(self, section: str, key: str) -> Optional[str]:
+        return self.values.get((section, key))
+
+    def line(self, section: str, key: Optional[str] = None) -> int:
+        """Line of ``[section]key`` (of the section header when key is
+        None); 0 when absent."""
+        if key is None:
+            return self.section_lines.get(section, 0)
+        return self.lines.get((section, key), 0)
+
+    def has_section(self, section: str) -> bool:
+        return section in self.section_lines
+
+    def items(self, section: str) -> Iterator[tuple[str, str]]:
+        """The ``(key, value)`` entries of a section, in file order."""
+        for (sec, key), value in self.values.items():
+            if sec == section:
+                yield key, value
+
+    def where(self, section: str, key: Optional[str] = None) -> str:
+        """``path:line`` of an entry (or ``path`` when it is absent)."""
+        n = self.line(section, key)
+        return f"{self.path}:{n}" if n else self.path
