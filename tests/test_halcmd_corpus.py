@@ -36,15 +36,15 @@ TOOLS = ("halsampler", "halstreamer")
 def _env(name: str, tools: Path) -> dict:
     env = dict(os.environ)
     env["HALSDK_INSTANCE"] = f"tc-{os.getpid()}-{name}"
-    if not all(shutil.which(t) for t in TOOLS):
-        # the console scripts exist only after `pip install -e .`
-        tools.mkdir(exist_ok=True)
-        for tool in TOOLS:
-            script = tools / tool
-            script.write_text(f'#!/bin/sh\nexec "{sys.executable}" -m '
-                              f'halsdk.tools.{tool} "$@"\n')
-            script.chmod(0o755)
-        env["PATH"] = f"{tools}{os.pathsep}{env.get('PATH', '')}"
+    # the tools of this Python's halsdk, first on PATH: a halsampler of
+    # another installation (an older one on PATH) would not attach
+    tools.mkdir(exist_ok=True)
+    for tool in TOOLS:
+        script = tools / tool
+        script.write_text(f'#!/bin/sh\nexec "{sys.executable}" -m '
+                          f'halsdk.tools.{tool} "$@"\n')
+        script.chmod(0o755)
+    env["PATH"] = f"{tools}{os.pathsep}{env.get('PATH', '')}"
     return env
 
 
