@@ -9,6 +9,10 @@ extension module ``halsdk.components.<name>``:
   ``halsdk/src/c_module.c``), a Cython one (``option cython``) a generated
   ``.pyx``.  The generated files go to ``build/halcompile/``.
 - ``NAME.pyx`` is a component written in Cython against ``halsdk/hal.pxd``.
+- ``motion/MODULES`` lists the modules of the motion controller (motmod,
+  homemod, tpmod, the kinematics) and their C/C++ sources in
+  ``components/motion/``; C++ sources link ruckig (a build requirement)
+  statically.
 """
 
 import glob
@@ -99,6 +103,59 @@ components += [
     )
     for src in sorted(glob.glob("components/*.pyx"))
 ]
+
+
+def ruckig_dirs():
+    """Include folder and static library of the ruckig wheel."""
+    try:
+        import ruckig
+    except ImportError:
+        sys.exit("error: building the motion modules needs ruckig "
+                 "(pip install ruckig)")
+    root = os.path.dirname(ruckig.__file__)
+    lib = os.path.join(root, "lib64", "libruckig.a")
+    if not os.path.exists(lib):
+        lib = os.path.join(root, "lib", "libruckig.a")
+    return os.path.join(root, "include"), lib
+
+
+def motion_extensions():
+    """The modules listed in components/motion/MODULES."""
+    folder = os.path.join("components", "motion")
+    exts = []
+    with open(os.path.join(folder, "MODULES"), encoding="utf-8") as f:
+        lines = f.read().splitlines()
+    for number, line in enumerate(lines, 1):
+        line = line.split("#")[0].strip()
+        if not line:
+            continue
+        name, sep, files = line.partition(":")
+        if not sep or not files.split():
+            sys.exit(f"error: {folder}/MODULES:{number}: expected "
+                     "'module: source...'")
+        sources = [os.path.join(folder, f) for f in files.split()]
+        cxx = any(f.endswith(".cpp") for f in sources)
+        extra = {}
+        if cxx:
+            include, lib = ruckig_dirs()
+            # ruckig's headers need no exceptions; a realtime call must
+            # not throw
+            extra = {"extra_objects": [lib], "language": "c++"}
+        exts.append(Extension(
+            "halsdk.components." + name.strip(),
+            sources=["halsdk/src/c_module.c"] + sources,
+            include_dirs=["halsdk/include", folder]
+            + ([include] if cxx else []),
+            define_macros=[("HALSDK_MODULE_NAME", name.strip()),
+                           ("HALSDK_API_EXTERN", "1"), ("RTAPI", None)],
+            extra_compile_args=["-O2", "-Wall", "-Wno-unused-function",
+                                "-fvisibility=hidden"]
+            + (["-fno-exceptions"] if cxx else []),
+            **extra))
+    return exts
+
+
+components += motion_extensions()
 names = [e.name for e in components]
 if len(set(names)) != len(names):
     sys.exit("error: two sources in components/ make the same module")

@@ -24,7 +24,8 @@ DOCS = os.path.join(ROOT, "docs")
 PAGES = ["index", "concepts", "components", "halcmd", "halcompile",
          "python-api",
          "cython-components",
-         "c-components", "design", "compat", "benchmarks"]
+         "c-components", "kinematics", "design",
+         "compat", "benchmarks"]
 
 
 @pytest.fixture(scope="module")
