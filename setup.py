@@ -156,13 +156,18 @@ def motion_extensions():
 
 
 components += motion_extensions()
+components.append(Extension(
+    "halsdk.motion._channel", sources=["halsdk/motion/_channel.pyx"],
+    include_dirs=["components/motion", "halsdk/include"],
+    extra_compile_args=FLAGS))
 names = [e.name for e in components]
 if len(set(names)) != len(names):
     sys.exit("error: two sources in components/ make the same module")
 
 setup(
     packages=["halsdk", "halsdk.compat", "halsdk.demo", "halsdk.halcmd",
-              "halsdk.components", "halsdk.tools", "halcompile"],
+              "halsdk.components", "halsdk.motion", "halsdk.tools",
+              "halcompile"],
     package_dir={"halsdk.components": "components"},
     ext_modules=cythonize([core] + components, language_level=3, quiet=True,
                           include_path=["."]),

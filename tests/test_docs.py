@@ -24,7 +24,7 @@ DOCS = os.path.join(ROOT, "docs")
 PAGES = ["index", "concepts", "components", "halcmd", "halcompile",
          "python-api",
          "cython-components",
-         "c-components", "kinematics", "design",
+         "c-components", "motion", "homing", "kinematics", "design",
          "compat", "benchmarks"]
 
 

@@ -1,0 +1,499 @@
+# cython: language_level=3, boundscheck=False, wraparound=False
+"""Low-level access to motmod's command channel (components/motion/
+channel.h): the client lock, sending a command record, reading the echo,
+a consistent status snapshot (seqlock) and the error message ring.
+
+This module only moves bytes with the right memory ordering; waiting,
+timeouts and decoding belong to :mod:`halsdk.motion.client`.
+"""
+
+from cpython.pycapsule cimport PyCapsule_GetPointer
+from libc.stdint cimport int32_t, uint32_t, uint64_t, uintptr_t
+from libc.string cimport memcpy, memset
+
+cdef extern from *:
+    """
+    #include <errno.h>
+    #include <signal.h>
+    static inline uint32_t mch_load32(volatile uint32_t *p)
+    { return __atomic_load_n(p, __ATOMIC_ACQUIRE); }
+    static inline uint64_t mch_load64(volatile uint64_t *p)
+    { return __atomic_load_n(p, __ATOMIC_ACQUIRE); }
+    static inline void mch_store32(volatile uint32_t *p, uint32_t v)
+    { __atomic_store_n(p, v, __ATOMIC_RELEASE); }
+    static inline void mch_store_i32(int32_t *p, int32_t v)
+    { __atomic_store_n(p, v, __ATOMIC_RELEASE); }
+    static inline int mch_cas_i32(int32_t *p, int32_t from, int32_t to)
+    { return __atomic_compare_exchange_n(p, &from, to, 0, __ATOMIC_ACQ_REL,
+                                         __ATOMIC_ACQUIRE); }
+    static inline int32_t mch_load_i32(int32_t *p)
+    { return __atomic_load_n(p, __ATOMIC_ACQUIRE); }
+    static inline void mch_acquire(void)
+    { __atomic_thread_fence(__ATOMIC_ACQUIRE); }
+    static inline void mch_release(void)
+    { __atomic_thread_fence(__ATOMIC_RELEASE); }
+    static inline int mch_pid_dead(int pid)
+    { return kill(pid, 0) < 0 && errno == ESRCH; }
+    #include <sched.h>
+    #include <time.h>
+    static inline double mch_now(void)
+    {
+        struct timespec t;
+        clock_gettime(CLOCK_MONOTONIC, &t);
+        return t.tv_sec + 1e-9 * t.tv_nsec;
+    }
+    """
+    uint32_t mch_load32(volatile uint32_t *p) nogil
+    uint64_t mch_load64(volatile uint64_t *p) nogil
+    void mch_store32(volatile uint32_t *p, uint32_t v) nogil
+    void mch_store_i32(int32_t *p, int32_t v) nogil
+    bint mch_cas_i32(int32_t *p, int32_t frm, int32_t to) nogil
+    int32_t mch_load_i32(int32_t *p) nogil
+    void mch_acquire() nogil
+    void mch_release() nogil
+    bint mch_pid_dead(int pid) nogil
+    double mch_now() nogil
+    int sched_yield() nogil
+
+cdef extern from "halsdk_api.h":
+    ctypedef struct halsdk_api:
+        int version
+        long long (*shmem_attach)(const char *name)
+        void *(*shmem_ptr)(long long handle)
+        long (*shmem_size)(long long handle)
+
+cdef extern from "emcpose.h":
+    ctypedef struct PmCartesian:
+        double x, y, z
+    ctypedef struct EmcPose:
+        PmCartesian tran
+        double a, b, c, u, v, w
+
+cdef extern from "channel.h":
+    int MOT_CHANNEL_MAGIC, MOT_CHANNEL_VERSION, MOT_MAX_JOINTS
+    int MOT_MAX_AXES, MOT_REASON_LEN, MOT_MSG_LEN, MOT_MSG_RING
+
+    ctypedef struct mot_command_t:
+        int32_t cmd, joint, axis, ival, index, id, motion_type, turn
+        double vel, ini_maxvel, acc, jerk, offset, value
+        double min_limit, max_limit, tolerance
+        double comp[3]
+        EmcPose pos
+        PmCartesian center, normal
+        double home_offset, home, home_search_vel, home_latch_vel
+        double home_final_vel
+        int32_t home_sequence, volatile_home
+        uint32_t home_flags
+
+    ctypedef struct mot_joint_status_t:
+        uint32_t flags
+        int32_t home_state
+        double pos_cmd, pos_fb, vel_cmd, acc_cmd, ferror, ferror_limit
+        double ferror_high_mark, motor_offset, motor_pos_cmd, motor_pos_fb
+        double backlash_filt, min_pos_limit, max_pos_limit, vel_limit
+        double acc_limit, jerk_limit, min_ferror, max_ferror, backlash
+        double free_target
+        int32_t free_active, jog_active
+
+    ctypedef struct mot_axis_status_t:
+        double pos_cmd, vel_cmd, teleop_pos, teleop_vel, teleop_target
+        double min_pos_limit, max_pos_limit, vel_limit, acc_limit
+        double jerk_limit
+        int32_t teleop_active, jog_active
+
+    ctypedef struct mot_status_t:
+        uint64_t heartbeat
+        int32_t mode, enabled, in_position, on_soft_limit, override_limits
+        int32_t num_joints, num_joints_loaded, num_extrajoints, kins_type
+        int32_t homing, all_homed, paused, probing, probe_tripped
+        int32_t queue_depth, motion_id, motion_type, profile, coord_error
+        int32_t error, num_dio, num_aio, num_spindles, term_cond
+        double feed_scale, rapid_scale, current_vel, distance_to_go
+        double requested_vel, vel_limit, acc_limit, tolerance
+        double servo_period, traj_period
+        EmcPose carte_pos_cmd, carte_pos_fb
+        int32_t carte_pos_fb_ok
+        EmcPose probed_pos, tool_offset
+        uint64_t dout, din
+        mot_joint_status_t joint[16]
+        mot_axis_status_t axis[9]
+
+    ctypedef struct mot_msg_t:
+        uint64_t n
+        char text[200]
+
+    ctypedef struct mot_channel_t:
+        uint32_t magic, version, size
+        int32_t lock_pid
+        uint32_t cmd_seq, echo_seq
+        int32_t echo_status, echo_cmd
+        char echo_reason[200]
+        mot_command_t command
+        uint32_t status_seq
+        mot_status_t status
+        uint64_t msg_count
+        mot_msg_t msgs[32]
+
+
+class ChannelError(Exception):
+    """The block is missing, gone, or not a channel of this version."""
+
+
+cdef const halsdk_api *_api = NULL
+
+
+cdef const halsdk_api *get_api() except NULL:
+    global _api
+    if _api == NULL:
+        from halsdk import _core
+        _api = <const halsdk_api *>PyCapsule_GetPointer(
+            _core._C_API, b"halsdk._core._C_API")
+        if _api.version < 4:
+            _api = NULL
+            raise ChannelError("the halsdk core is too old for the motion "
+                               "channel (C API version 4 needed)")
+    return _api
+
+
+cdef tuple _pose(EmcPose *p):
+    return (p.tran.x, p.tran.y, p.tran.z, p.a, p.b, p.c, p.u, p.v, p.w)
+
+
+cdef void _set_pose(EmcPose *p, object v) except *:
+    if len(v) != 9:
+        raise ValueError("a pose needs 9 values (X Y Z A B C U V W)")
+    p.tran.x, p.tran.y, p.tran.z = v[0], v[1], v[2]
+    p.a, p.b, p.c, p.u, p.v, p.w = v[3], v[4], v[5], v[6], v[7], v[8]
+
+
+cdef void _set_cart(PmCartesian *p, object v) except *:
+    if len(v) != 3:
+        raise ValueError("a vector needs 3 values (X Y Z)")
+    p.x, p.y, p.z = v[0], v[1], v[2]
+
+
+_INT_FIELDS = ("joint", "axis", "ival", "index", "id", "motion_type",
+               "turn", "home_sequence", "volatile_home")
+_FLOAT_FIELDS = ("vel", "ini_maxvel", "acc", "jerk", "offset", "value",
+                 "min_limit", "max_limit", "tolerance", "home_offset",
+                 "home", "home_search_vel", "home_latch_vel",
+                 "home_final_vel")
+_KNOWN = set(_INT_FIELDS + _FLOAT_FIELDS +
+             ("home_flags", "comp", "pos", "center", "normal"))
+
+SIZE = sizeof(mot_channel_t)
+MAX_JOINTS = MOT_MAX_JOINTS
+MSG_RING = MOT_MSG_RING
+
+
+cdef class Channel:
+    """The channel block named ``name`` in the attached HAL instance."""
+
+    cdef mot_channel_t *ch
+    cdef long long handle
+    cdef readonly str name
+    cdef readonly int pid
+
+    def __init__(self, str name, int pid):
+        cdef const halsdk_api *api = get_api()
+        from halsdk import _core
+        addr, size = _core.shmem_attach(name)    # NotFoundError if none
+        cdef bytes b = name.encode()
+        self.handle = api.shmem_attach(b)
+        if self.handle < 0:
+            raise ChannelError(f"shared block '{name}' vanished")
+        self.ch = <mot_channel_t *>api.shmem_ptr(self.handle)
+        self.name = name
+        self.pid = pid
+        if self.ch == NULL or <uintptr_t>self.ch != <uintptr_t>addr:
+            raise ChannelError(f"shared block '{name}' vanished")
+        if size < sizeof(mot_channel_t):
+            raise ChannelError(
+                f"shared block '{name}' has {size} bytes, a motion channel "
+                f"needs {sizeof(mot_channel_t)}")
+        if self.ch.magic != MOT_CHANNEL_MAGIC:
+            raise ChannelError(f"shared block '{name}' is not a motion "
+                               f"channel (magic {self.ch.magic:#x})")
+        if self.ch.version != MOT_CHANNEL_VERSION:
+            raise ChannelError(
+                f"motion channel '{name}' has version {self.ch.version}, "
+                f"this client speaks version {MOT_CHANNEL_VERSION}")
+        if self.ch.size < sizeof(mot_channel_t):
+            raise ChannelError(
+                f"motion channel '{name}' declares {self.ch.size} bytes, "
+                f"this client needs {sizeof(mot_channel_t)}")
+
+    cdef mot_channel_t *live(self) except NULL:
+        """The block, or ChannelError when its owner went away."""
+        if self.ch == NULL or _api.shmem_ptr(self.handle) != <void *>self.ch:
+            self.ch = NULL
+            raise ChannelError(f"motion channel '{self.name}' is gone "
+                               "(motmod was unloaded)")
+        return self.ch
+
+    def alive(self) -> bool:
+        return (self.ch != NULL and
+                _api.shmem_ptr(self.handle) == <void *>self.ch)
+
+    # ---------------------------------------------------------- lock
+
+    def try_lock(self) -> int:
+        """Take the client lock; returns 0, or the pid of the live
+        process that holds it."""
+        cdef mot_channel_t *c = self.live()
+        cdef int32_t owner
+        while True:
+            if mch_cas_i32(&c.lock_pid, 0, self.pid):
+                return 0
+            owner = mch_load_i32(&c.lock_pid)
+            if owner == 0:
+                continue
+            # our own pid: a lock this process left (the Python side
+            # serializes its own senders)
+            if owner == self.pid or mch_pid_dead(owner):
+                if mch_cas_i32(&c.lock_pid, owner, self.pid):
+                    return 0
+                continue
+            return owner
+
+    def unlock(self):
+        cdef mot_channel_t *c = self.live()
+        mch_cas_i32(&c.lock_pid, self.pid, 0)
+
+    # ---------------------------------------------------------- commands
+
+    def idle(self) -> bool:
+        """The handler has taken the last command (echo_seq == cmd_seq)."""
+        cdef mot_channel_t *c = self.live()
+        return mch_load32(&c.echo_seq) == mch_load32(&c.cmd_seq)
+
+    def send(self, int cmd, dict args) -> int:
+        """Write a command record and publish it; returns its sequence
+        number.  The caller holds the lock and has seen idle()."""
+        cdef mot_channel_t *c = self.live()
+        cdef mot_command_t rec
+        cdef uint32_t seq
+        unknown = set(args) - _KNOWN
+        if unknown:
+            raise TypeError(f"unknown command field(s) {sorted(unknown)}")
+        memset(&rec, 0, sizeof(rec))
+        rec.cmd = cmd
+        rec.joint = -1
+        rec.axis = -1
+        for k in _INT_FIELDS:
+            if k in args:
+                setattr_int(&rec, k, args[k])
+        for k in _FLOAT_FIELDS:
+            if k in args:
+                setattr_float(&rec, k, args[k])
+        if "home_flags" in args:
+            rec.home_flags = args["home_flags"]
+        if "comp" in args:
+            v = args["comp"]
+            if len(v) != 3:
+                raise ValueError("comp needs 3 values")
+            rec.comp[0], rec.comp[1], rec.comp[2] = v[0], v[1], v[2]
+        if "pos" in args:
+            _set_pose(&rec.pos, args["pos"])
+        if "center" in args:
+            _set_cart(&rec.center, args["center"])
+        if "normal" in args:
+            _set_cart(&rec.normal, args["normal"])
+        memcpy(&c.command, &rec, sizeof(rec))
+        seq = mch_load32(&c.cmd_seq) + 1
+        if seq == 0:
+            seq = 1
+        mch_release()
+        mch_store32(&c.cmd_seq, seq)
+        return seq
+
+    def echo(self) -> tuple:
+        """(echo_seq, echo_status, echo_cmd, reason) as last published."""
+        cdef mot_channel_t *c = self.live()
+        cdef uint32_t seq = mch_load32(&c.echo_seq)
+        cdef int32_t st = c.echo_status
+        cdef int32_t code = c.echo_cmd
+        cdef char reason[200]
+        memcpy(reason, c.echo_reason, 200)
+        reason[199] = 0
+        return seq, st, code, reason.decode("utf-8", "replace")
+
+    # ---------------------------------------------------------- status
+
+    def status(self, double timeout=2.0) -> dict:
+        """One consistent snapshot of the status, as a dict of plain
+        values (joints and axes as lists of dicts)."""
+        cdef mot_channel_t *c = self.live()
+        cdef mot_status_t st
+        cdef uint32_t s1, s2
+        cdef long k = 0
+        cdef double end = 0
+        cdef bint ok = False
+        with nogil:
+            while True:
+                s1 = mch_load32(&c.status_seq)
+                if not (s1 & 1):
+                    memcpy(&st, <void *>&c.status, sizeof(st))
+                    mch_acquire()
+                    s2 = mch_load32(&c.status_seq)
+                    if s1 == s2:
+                        ok = True
+                        break
+                # the writer is in the middle of an update: spin a little,
+                # then let it run (it may share our CPU)
+                k += 1
+                if k > 100:
+                    if end == 0:
+                        end = mch_now() + timeout
+                    elif mch_now() > end:
+                        break
+                    sched_yield()
+        if not ok:
+            raise ChannelError("no consistent status snapshot within "
+                               f"{timeout:g} s (the writer never finishes "
+                               "an update)")
+        return _status_dict(&st)
+
+    # ---------------------------------------------------------- messages
+
+    def msg_count(self) -> int:
+        cdef mot_channel_t *c = self.live()
+        return mch_load64(&c.msg_count)
+
+    def messages(self, uint64_t r) -> tuple:
+        """Messages from number r on: (list of texts, next r, lost)."""
+        cdef mot_channel_t *c = self.live()
+        cdef uint64_t count = mch_load64(&c.msg_count)
+        cdef mot_msg_t m
+        cdef uint64_t lost = 0
+        out = []
+        while r < count:
+            if count - r >= MOT_MSG_RING:
+                lost += count - MOT_MSG_RING + 1 - r
+                r = count - MOT_MSG_RING + 1
+            memcpy(&m, <void *>&c.msgs[r % MOT_MSG_RING], sizeof(m))
+            mch_acquire()
+            count = mch_load64(&c.msg_count)
+            if count - r >= MOT_MSG_RING:
+                continue        # overwritten while copying: skip ahead
+            if m.n != r:        # not the message expected: drop it
+                lost += 1
+                r += 1
+                continue
+            m.text[199] = 0
+            out.append(m.text.decode("utf-8", "replace"))
+            r += 1
+        return out, r, lost
+
+
+cdef void setattr_int(mot_command_t *r, str k, object v) except *:
+    cdef int32_t x = v
+    if k == "joint":
+        r.joint = x
+    elif k == "axis":
+        r.axis = x
+    elif k == "ival":
+        r.ival = x
+    elif k == "index":
+        r.index = x
+    elif k == "id":
+        r.id = x
+    elif k == "motion_type":
+        r.motion_type = x
+    elif k == "turn":
+        r.turn = x
+    elif k == "home_sequence":
+        r.home_sequence = x
+    elif k == "volatile_home":
+        r.volatile_home = x
+
+
+cdef void setattr_float(mot_command_t *r, str k, object v) except *:
+    cdef double x = v
+    if k == "vel":
+        r.vel = x
+    elif k == "ini_maxvel":
+        r.ini_maxvel = x
+    elif k == "acc":
+        r.acc = x
+    elif k == "jerk":
+        r.jerk = x
+    elif k == "offset":
+        r.offset = x
+    elif k == "value":
+        r.value = x
+    elif k == "min_limit":
+        r.min_limit = x
+    elif k == "max_limit":
+        r.max_limit = x
+    elif k == "tolerance":
+        r.tolerance = x
+    elif k == "home_offset":
+        r.home_offset = x
+    elif k == "home":
+        r.home = x
+    elif k == "home_search_vel":
+        r.home_search_vel = x
+    elif k == "home_latch_vel":
+        r.home_latch_vel = x
+    elif k == "home_final_vel":
+        r.home_final_vel = x
+
+
+cdef dict _joint_dict(mot_joint_status_t *j):
+    return dict(
+        flags=j.flags, home_state=j.home_state, pos_cmd=j.pos_cmd,
+        pos_fb=j.pos_fb, vel_cmd=j.vel_cmd, acc_cmd=j.acc_cmd,
+        ferror=j.ferror, ferror_limit=j.ferror_limit,
+        ferror_high_mark=j.ferror_high_mark, motor_offset=j.motor_offset,
+        motor_pos_cmd=j.motor_pos_cmd, motor_pos_fb=j.motor_pos_fb,
+        backlash_filt=j.backlash_filt, min_pos_limit=j.min_pos_limit,
+        max_pos_limit=j.max_pos_limit, vel_limit=j.vel_limit,
+        acc_limit=j.acc_limit, jerk_limit=j.jerk_limit,
+        min_ferror=j.min_ferror, max_ferror=j.max_ferror,
+        backlash=j.backlash, free_target=j.free_target,
+        free_active=j.free_active != 0, jog_active=j.jog_active != 0)
+
+
+cdef dict _axis_dict(mot_axis_status_t *a):
+    return dict(
+        pos_cmd=a.pos_cmd, vel_cmd=a.vel_cmd, teleop_pos=a.teleop_pos,
+        teleop_vel=a.teleop_vel, teleop_target=a.teleop_target,
+        min_pos_limit=a.min_pos_limit, max_pos_limit=a.max_pos_limit,
+        vel_limit=a.vel_limit, acc_limit=a.acc_limit,
+        jerk_limit=a.jerk_limit, teleop_active=a.teleop_active != 0,
+        jog_active=a.jog_active != 0)
+
+
+cdef dict _status_dict(mot_status_t *s):
+    cdef int n = s.num_joints_loaded
+    cdef int i
+    if n < 0:
+        n = 0
+    if n > MOT_MAX_JOINTS:
+        n = MOT_MAX_JOINTS
+    return dict(
+        heartbeat=s.heartbeat, mode=s.mode, enabled=s.enabled != 0,
+        in_position=s.in_position != 0, on_soft_limit=s.on_soft_limit != 0,
+        override_limits=s.override_limits != 0, num_joints=s.num_joints,
+        num_joints_loaded=s.num_joints_loaded,
+        num_extrajoints=s.num_extrajoints, kins_type=s.kins_type,
+        homing=s.homing != 0, all_homed=s.all_homed != 0,
+        paused=s.paused != 0, probing=s.probing != 0,
+        probe_tripped=s.probe_tripped != 0, queue_depth=s.queue_depth,
+        motion_id=s.motion_id, motion_type=s.motion_type,
+        profile=s.profile, coord_error=s.coord_error != 0,
+        error=s.error != 0, num_dio=s.num_dio, num_aio=s.num_aio,
+        num_spindles=s.num_spindles, term_cond=s.term_cond,
+        feed_scale=s.feed_scale, rapid_scale=s.rapid_scale,
+        current_vel=s.current_vel, distance_to_go=s.distance_to_go,
+        requested_vel=s.requested_vel, vel_limit=s.vel_limit,
+        acc_limit=s.acc_limit, tolerance=s.tolerance,
+        servo_period=s.servo_period, traj_period=s.traj_period,
+        carte_pos_cmd=_pose(&s.carte_pos_cmd),
+        carte_pos_fb=_pose(&s.carte_pos_fb),
+        carte_pos_fb_ok=s.carte_pos_fb_ok != 0,
+        probed_pos=_pose(&s.probed_pos), tool_offset=_pose(&s.tool_offset),
+        dout=s.dout, din=s.din,
+        joints=[_joint_dict(&s.joint[i]) for i in range(n)],
+        axes=[_axis_dict(&s.axis[i]) for i in range(MOT_MAX_AXES)])

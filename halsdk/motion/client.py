@@ -1,0 +1,1002 @@
+"""The Python client of the motion controller (motmod).
+
+A :class:`Motion` object talks to motmod through the shared command
+channel (``components/motion/channel.h``): it sends one command at a
+time, waits for motmod's echo and raises :class:`Rejected` with motmod's
+reason when the command was refused.  :meth:`Motion.status` returns a
+consistent snapshot; :meth:`Motion.errors` the realtime error messages.
+
+Waiting is deterministic when the client is given the :class:`halsdk.Hal`
+object of the instance and its threads are not running in real time: the
+client then steps the servo thread itself, one cycle at a time, until the
+echo (or the awaited condition) arrives.  Otherwise it polls with short
+sleeps until a timeout of wall-clock time.
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+import os
+import threading
+import time
+from collections.abc import Iterable, Mapping, Sequence
+from typing import Any, Callable, Optional, Union
+
+from halsdk import _core
+from halsdk.errors import HalError, NotFoundError
+from halsdk.motion import _channel
+from halsdk.motion.status import (
+    AXES,
+    JOINT_HOMED,
+    Mode,
+    MotionType,
+    Pose,
+    Profile,
+    Status,
+    TermCond,
+)
+
+__all__ = ["Motion", "Rejected", "MotionError", "MotionTimeout", "Cmd"]
+
+CHANNEL_NAME = "motmod.channel"
+
+
+class MotionError(HalError):
+    """The motion channel is missing, gone or of another version, or a
+    wait ended without the awaited result."""
+
+
+class MotionTimeout(MotionError, TimeoutError):
+    """A wait did not end within its timeout."""
+
+
+class Rejected(HalError):
+    """motmod refused a command; nothing was done.
+
+    :ivar command: the command's name (e.g. ``"JOG_INCR"``).
+    :ivar reason: motmod's reason, one sentence.
+    """
+
+    def __init__(self, command: str, reason: str):
+        super().__init__(f"{command} rejected: {reason}")
+        self.command = command
+        self.reason = reason
+
+
+class Cmd(enum.IntEnum):
+    """Command codes of channel.h (part of the protocol)."""
+    ABORT = 1
+    FREE = 2
+    TELEOP = 3
+    COORD = 4
+    ENABLE = 5
+    DISABLE = 6
+    ENABLE_AMPLIFIER = 7
+    DISABLE_AMPLIFIER = 8
+    ACTIVATE_JOINT = 9
+    DEACTIVATE_JOINT = 10
+    PAUSE = 11
+    RESUME = 12
+    STEP = 13
+    SCALE = 14
+    RAPID_SCALE = 15
+    OVERRIDE_LIMITS = 16
+    HOME = 20
+    UNHOME = 21
+    JOG_CONT = 30
+    JOG_INCR = 31
+    JOG_ABS = 32
+    JOG_STOP = 33
+    SET_LINE = 40
+    SET_CIRCLE = 41
+    SET_TELEOP_VECTOR = 42
+    PROBE = 43
+    CLEAR_PROBE_FLAG = 44
+    SET_NUM_JOINTS = 50
+    SET_JOINT_POSITION_LIMITS = 51
+    SET_JOINT_VEL_LIMIT = 52
+    SET_JOINT_ACC_LIMIT = 53
+    SET_JOINT_JERK_LIMIT = 54
+    SET_JOINT_MIN_FERROR = 55
+    SET_JOINT_MAX_FERROR = 56
+    SET_JOINT_HOMING_PARAMS = 57
+    SET_JOINT_BACKLASH = 58
+    SET_JOINT_COMP = 59
+    CLEAR_JOINT_COMP = 60
+    SET_JOINT_MOTOR_OFFSET = 61
+    SET_AXIS_POSITION_LIMITS = 62
+    SET_AXIS_VEL_LIMIT = 63
+    SET_AXIS_ACC_LIMIT = 64
+    SET_AXIS_JERK_LIMIT = 65
+    SET_VEL = 66
+    SET_VEL_LIMIT = 67
+    SET_ACC = 68
+    SET_TERM_COND = 69
+    SET_OFFSET = 70
+    SET_PROFILE = 71
+    SET_DOUT = 72
+    SET_AOUT = 73
+
+
+class Echo(enum.IntEnum):
+    NONE = 0
+    DONE = 1            #: carried out completely
+    ACCEPTED = 2        #: started; goes on in later cycles
+    REJECTED = 3
+
+
+# homing flags (homing.h)
+HOME_IGNORE_LIMITS = 0x0001
+HOME_USE_INDEX = 0x0002
+HOME_IS_SHARED = 0x0004
+HOME_UNLOCK_FIRST = 0x0008
+HOME_ABSOLUTE_ENCODER = 0x0010
+HOME_NO_REHOME = 0x0020
+HOME_NO_FINAL_MOVE = 0x0040
+HOME_INDEX_NO_ENCODER_RESET = 0x0080
+
+# home_sequence when HOME_SEQUENCE is not set (homing.h)
+HOME_SEQUENCE_NONE = -1000
+
+# probe type bits
+PROBE_NO_ERROR = 0x1
+PROBE_AWAY = 0x2
+
+# one sender at a time in this process (the channel lock is per process)
+_send_lock = threading.RLock()
+
+PoseLike = Union[Sequence[float], Mapping[str, float], Pose]
+JointOrAxis = Union[int, str]
+
+
+def _axis_index(letter: str) -> int:
+    i = AXES.find(letter.lower()) if len(letter) == 1 else -1
+    if i < 0:
+        raise ValueError(f"unknown axis letter {letter!r} (one of "
+                         "X Y Z A B C U V W)")
+    return i
+
+
+class Motion:
+    """A connection to the motion controller of the attached HAL instance.
+
+    Use :meth:`connect`.  Every command method waits for motmod's echo and
+    raises :class:`Rejected` (with the reason) when the command is refused;
+    commands that start motion return when the motion has started — use
+    :meth:`wait_done`, :meth:`wait_inpos`, :meth:`wait_homed` or
+    :meth:`wait_for` to wait for its end.
+    """
+
+    def __init__(self, channel: _channel.Channel, hal: Any = None,
+                 thread: str = "servo-thread", timeout: float = 5.0,
+                 own_hal: Any = None):
+        self._ch = channel
+        self._hal = hal
+        self._own_hal = own_hal
+        self.thread = thread
+        self.timeout = timeout
+        self._msg_read = channel.msg_count()
+        self._pending: list[str] = []
+        self._next_id = 1
+        self._last_end: Optional[Pose] = None
+
+    # ------------------------------------------------------------ connect
+
+    @classmethod
+    def connect(cls, hal: Any = None, name: str = CHANNEL_NAME, *,
+                thread: str = "servo-thread", timeout: float = 5.0
+                ) -> Motion:
+        """Attach to motmod's channel block ``name``.
+
+        :param hal: the :class:`halsdk.Hal` of the instance.  When given
+            and its threads are not running in real time, waits step
+            ``thread`` deterministically.  Without it, the client attaches
+            to the user's instance (``halsdk.Hal()``) and polls.
+        :param timeout: default timeout of waits, seconds (simulated time
+            when stepping).
+        :raises MotionError: no channel (motmod not loaded), or one of
+            another version or size.
+        """
+        own = None
+        if hal is None and not _core.attached():
+            import halsdk
+            own = halsdk.Hal(create=False)
+        try:
+            ch = _channel.Channel(name, os.getpid())
+        except NotFoundError:
+            if own is not None:
+                own.close()
+            raise MotionError(
+                f"no motion channel '{name}' in HAL instance: is motmod "
+                "loaded?") from None
+        except _channel.ChannelError as e:
+            if own is not None:
+                own.close()
+            raise MotionError(str(e)) from None
+        return cls(ch, hal, thread, timeout, own)
+
+    def close(self) -> None:
+        """Forget the channel (and detach if connect() attached)."""
+        if self._own_hal is not None:
+            self._own_hal.close()
+            self._own_hal = None
+
+    def __enter__(self) -> Motion:
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.close()
+
+    # ------------------------------------------------------------ waiting
+
+    def _stepping(self) -> bool:
+        return (self._hal is not None and
+                not _core.info()["threads_running"])
+
+    def _wait(self, cond: Callable[[], Any], timeout: Optional[float],
+              what: str) -> Any:
+        """Wait until cond() returns something true; return it."""
+        if timeout is None:
+            timeout = self.timeout
+        try:
+            r = cond()
+            if r:
+                return r
+            if self._stepping():
+                period = self._servo_period()
+                for _ in range(max(1, math.ceil(timeout / period))):
+                    self._hal.step(1, thread=self.thread)
+                    r = cond()
+                    if r:
+                        return r
+                raise MotionTimeout(
+                    f"timeout: {what} did not happen within {timeout:g} s "
+                    f"of simulated time ({self.thread} stepped)")
+            end = time.monotonic() + timeout
+            beat = self._heartbeat()
+            while time.monotonic() < end:
+                time.sleep(0.001)
+                r = cond()
+                if r:
+                    return r
+            note = ""
+            if self._heartbeat() == beat:
+                note = (" — the servo thread did not run at all (start the "
+                        "threads, or pass hal= to step them)")
+            raise MotionTimeout(f"timeout: {what} did not happen within "
+                                f"{timeout:g} s{note}")
+        except _channel.ChannelError as e:
+            raise MotionError(str(e)) from None
+
+    def _servo_period(self) -> float:
+        p = self._ch.status()["servo_period"]
+        return p if p > 0 else 0.001
+
+    def _heartbeat(self) -> int:
+        return self._ch.status()["heartbeat"]
+
+    # ------------------------------------------------------------ commands
+
+    def command(self, cmd: Cmd, timeout: Optional[float] = None,
+                **fields: Any) -> Echo:
+        """Send one command record (fields of channel.h's mot_command_t)
+        and wait for its echo; returns DONE or ACCEPTED, raises
+        :class:`Rejected` with motmod's reason."""
+        cmd = Cmd(cmd)
+        ch = self._ch
+        with _send_lock:
+            try:
+                self._wait(lambda: ch.try_lock() == 0, timeout,
+                           f"{cmd.name}: the channel lock (held by another "
+                           "process)")
+                try:
+                    self._wait(ch.idle, timeout,
+                               f"{cmd.name}: motmod taking the previous "
+                               "command")
+                    seq = ch.send(int(cmd), fields)
+                    echo = self._wait(
+                        lambda: (e := ch.echo())[0] == seq and e, timeout,
+                        f"{cmd.name}: motmod's answer (is "
+                        "motion-command-handler in a running thread?)")
+                finally:
+                    if ch.alive():
+                        ch.unlock()
+            except _channel.ChannelError as e:
+                raise MotionError(str(e)) from None
+        _, status, code, reason = echo
+        if status == Echo.REJECTED:
+            raise Rejected(cmd.name, reason or "no reason given")
+        if status not in (Echo.DONE, Echo.ACCEPTED):
+            raise MotionError(f"{cmd.name}: unexpected echo status "
+                              f"{status} from motmod")
+        return Echo(status)
+
+    @staticmethod
+    def _target(joint: JointOrAxis, teleop: bool) -> dict:
+        """joint=... or axis=... fields of a jog."""
+        if isinstance(joint, str):
+            return {"joint": -1, "axis": _axis_index(joint)}
+        if teleop:
+            return {"joint": -1, "axis": int(joint)}
+        return {"joint": int(joint)}
+
+    # modes and state
+
+    def abort(self) -> None:
+        """Stop all motion in any mode (always accepted)."""
+        self.command(Cmd.ABORT)
+
+    def free(self) -> None:
+        """Free mode: joints move on their own (needs all at rest)."""
+        self.command(Cmd.FREE)
+
+    def teleop(self) -> None:
+        """Teleop mode: axis velocities through kinematics (needs all at
+        rest; non-trivial kinematics need all joints homed)."""
+        self.command(Cmd.TELEOP)
+
+    def coord(self) -> None:
+        """Coordinated mode: the trajectory planner runs queued moves
+        (needs all at rest; non-trivial kinematics need homing)."""
+        self.command(Cmd.COORD)
+
+    def enable(self) -> None:
+        """Enable motion (amplifiers on, planners follow commands)."""
+        self.command(Cmd.ENABLE)
+
+    def disable(self) -> None:
+        """Disable motion: stop at once, amplifiers off."""
+        self.command(Cmd.DISABLE)
+
+    def enable_amplifier(self, joint: int) -> None:
+        self.command(Cmd.ENABLE_AMPLIFIER, joint=joint)
+
+    def disable_amplifier(self, joint: int) -> None:
+        self.command(Cmd.DISABLE_AMPLIFIER, joint=joint)
+
+    def activate_joint(self, joint: int) -> None:
+        self.command(Cmd.ACTIVATE_JOINT, joint=joint)
+
+    def deactivate_joint(self, joint: int) -> None:
+        self.command(Cmd.DEACTIVATE_JOINT, joint=joint)
+
+    def pause(self) -> None:
+        """Pause the coordinated planner (decelerates along the path)."""
+        self.command(Cmd.PAUSE)
+
+    def resume(self) -> None:
+        self.command(Cmd.RESUME)
+
+    def step(self) -> None:
+        """Resume and pause again at the end of the present move."""
+        self.command(Cmd.STEP)
+
+    def set_feed_scale(self, scale: float) -> None:
+        """Feed override of coordinated feed moves, >= 0."""
+        self.command(Cmd.SCALE, value=scale)
+
+    def set_rapid_scale(self, scale: float) -> None:
+        """Override of coordinated traverses, >= 0."""
+        self.command(Cmd.RAPID_SCALE, value=scale)
+
+    def override_limits(self, on: bool = True) -> None:
+        """Ignore limit switches until the end of the next jog (on), or
+        cancel such an override (off)."""
+        self.command(Cmd.OVERRIDE_LIMITS, ival=1 if on else 0)
+
+    # homing
+
+    def home(self, joint: int = -1) -> None:
+        """Start homing one joint, or -1: all joints with a sequence."""
+        self.command(Cmd.HOME, joint=joint)
+
+    def unhome(self, joint: int = -1) -> None:
+        """Mark unhomed: one joint, -1 all, -2 those with VOLATILE_HOME."""
+        self.command(Cmd.UNHOME, joint=joint)
+
+    # jogs
+
+    def jog_cont(self, joint: JointOrAxis, vel: float, *,
+                 teleop: bool = False) -> None:
+        """Jog continuously at the signed velocity ``vel`` until
+        :meth:`jog_stop`, :meth:`abort` or a limit.  ``joint`` is a joint
+        number (free mode) or an axis letter / number with
+        ``teleop=True`` (teleop mode)."""
+        self.command(Cmd.JOG_CONT, vel=vel, **self._target(joint, teleop))
+
+    def jog_incr(self, joint: JointOrAxis, vel: float, dist: float, *,
+                 teleop: bool = False) -> None:
+        """Move by ``dist`` (signed) at speed ``vel`` > 0; increments add
+        up when sent while the previous one still moves."""
+        self.command(Cmd.JOG_INCR, vel=vel, offset=dist,
+                     **self._target(joint, teleop))
+
+    def jog_abs(self, joint: JointOrAxis, vel: float, pos: float, *,
+                teleop: bool = False) -> None:
+        """Move to ``pos`` at speed ``vel`` > 0."""
+        self.command(Cmd.JOG_ABS, vel=vel, offset=pos,
+                     **self._target(joint, teleop))
+
+    def jog_stop(self, joint: JointOrAxis, *, teleop: bool = False) -> None:
+        """Stop the jog of one joint (or axis), decelerating."""
+        self.command(Cmd.JOG_STOP, **self._target(joint, teleop))
+
+    # coordinated moves
+
+    def _pose(self, p: PoseLike, what: str) -> tuple:
+        if isinstance(p, Mapping):
+            base = list(self._queue_end())
+            for k, v in p.items():
+                base[_axis_index(k)] = float(v)
+            return tuple(base)
+        vals = tuple(float(v) for v in p)
+        if len(vals) != 9:
+            raise ValueError(f"{what} needs 9 values (X Y Z A B C U V W) "
+                             f"or a mapping of axis letters, got "
+                             f"{len(vals)} values")
+        return vals
+
+    def _queue_end(self) -> Pose:
+        st = self._ch.status()
+        if st["queue_depth"] == 0 or self._last_end is None:
+            return Pose(*st["carte_pos_cmd"])
+        return self._last_end
+
+    def _move_fields(self, vel: float, ini_maxvel: Optional[float],
+                     acc: Optional[float], id: Optional[int]) -> dict:
+        if id is None:
+            id = self._next_id
+        self._next_id = id + 1
+        # 0: motmod uses its SET_VEL_LIMIT / SET_ACC values
+        return {"vel": vel, "ini_maxvel": ini_maxvel or 0.0,
+                "acc": acc or 0.0, "id": id}
+
+    def set_line(self, end: PoseLike, vel: float, *,
+                 acc: Optional[float] = None,
+                 ini_maxvel: Optional[float] = None,
+                 rapid: bool = False, id: Optional[int] = None,
+                 jerk: float = 0.0, flags: int = 0) -> int:
+        """Queue a straight move to ``end`` (9 values, or a mapping of
+        axis letters: the other axes stay where the last queued move
+        ends).  ``vel`` is the requested path velocity; ``ini_maxvel`` the
+        velocity never exceeded even with overrides (default: the
+        machine's velocity limit, SET_VEL_LIMIT); ``acc`` the
+        path acceleration (default: SET_ACC).  ``rapid``: a traverse (the
+        rapid scale applies).  Returns the motion id."""
+        p = self._pose(end, "SET_LINE end")
+        f = self._move_fields(vel, ini_maxvel, acc, id)
+        self.command(Cmd.SET_LINE, pos=p, jerk=jerk, ival=flags,
+                     motion_type=int(MotionType.TRAVERSE if rapid
+                                     else MotionType.FEED), **f)
+        self._last_end = Pose(*p)
+        return f["id"]
+
+    def set_circle(self, end: PoseLike, center: Sequence[float],
+                   normal: Sequence[float], vel: float, *, turn: int = 0,
+                   acc: Optional[float] = None,
+                   ini_maxvel: Optional[float] = None,
+                   id: Optional[int] = None) -> int:
+        """Queue an arc or helix to ``end`` around the axis through
+        ``center`` along ``normal`` (counterclockwise seen from the tip of
+        normal), with ``turn`` extra full turns.  Returns the motion id."""
+        p = self._pose(end, "SET_CIRCLE end")
+        f = self._move_fields(vel, ini_maxvel, acc, id)
+        self.command(Cmd.SET_CIRCLE, pos=p, center=tuple(center),
+                     normal=tuple(normal), turn=turn,
+                     motion_type=int(MotionType.ARC), **f)
+        self._last_end = Pose(*p)
+        return f["id"]
+
+    def probe(self, end: PoseLike, vel: float, *,
+              acc: Optional[float] = None,
+              ini_maxvel: Optional[float] = None, away: bool = False,
+              error_if_no_contact: bool = True,
+              id: Optional[int] = None) -> int:
+        """Queue a probe move toward ``end``: it stops and records the
+        position (status().probed_pos) when motion.probe-input trips (goes
+        true; false with ``away``).  Without contact the move ends at
+        ``end`` and, with ``error_if_no_contact``, motmod reports an
+        error.  Returns the motion id."""
+        p = self._pose(end, "PROBE end")
+        f = self._move_fields(vel, ini_maxvel, acc, id)
+        ptype = (PROBE_AWAY if away else 0) | \
+            (0 if error_if_no_contact else PROBE_NO_ERROR)
+        self.command(Cmd.PROBE, pos=p, ival=ptype,
+                     motion_type=int(MotionType.PROBING), **f)
+        self._last_end = Pose(*p)
+        return f["id"]
+
+    def clear_probe_flag(self) -> None:
+        self.command(Cmd.CLEAR_PROBE_FLAG)
+
+    def set_teleop_vector(self, vel: PoseLike) -> None:
+        """Teleop mode: move with this velocity of each axis (9 values or
+        a mapping of axis letters, others 0)."""
+        if isinstance(vel, Mapping):
+            v = [0.0] * 9
+            for k, x in vel.items():
+                v[_axis_index(k)] = float(x)
+        else:
+            v = [float(x) for x in vel]
+            if len(v) != 9:
+                raise ValueError("the teleop vector needs 9 values")
+        self.command(Cmd.SET_TELEOP_VECTOR, pos=tuple(v))
+
+    # configuration
+
+    def set_num_joints(self, n: int) -> None:
+        self.command(Cmd.SET_NUM_JOINTS, ival=n)
+
+    def set_joint_limits(self, joint: int, min_limit: float,
+                         max_limit: float) -> None:
+        """Soft limits of a joint (MIN_LIMIT, MAX_LIMIT)."""
+        self.command(Cmd.SET_JOINT_POSITION_LIMITS, joint=joint,
+                     min_limit=min_limit, max_limit=max_limit)
+
+    def set_joint_max_velocity(self, joint: int, vel: float) -> None:
+        self.command(Cmd.SET_JOINT_VEL_LIMIT, joint=joint, vel=vel)
+
+    def set_joint_max_acceleration(self, joint: int, acc: float) -> None:
+        self.command(Cmd.SET_JOINT_ACC_LIMIT, joint=joint, acc=acc)
+
+    def set_joint_max_jerk(self, joint: int, jerk: float) -> None:
+        """Jerk limit (> 0 also selects jerk-limited profiles)."""
+        self.command(Cmd.SET_JOINT_JERK_LIMIT, joint=joint, jerk=jerk)
+
+    def set_joint_ferror(self, joint: int, min_ferror: float,
+                         max_ferror: float) -> None:
+        """Following error limits: min_ferror at rest, max_ferror (FERROR)
+        at the joint's maximum velocity, in between by speed."""
+        self.command(Cmd.SET_JOINT_MIN_FERROR, joint=joint,
+                     value=min_ferror)
+        self.command(Cmd.SET_JOINT_MAX_FERROR, joint=joint,
+                     value=max_ferror)
+
+    def set_joint_backlash(self, joint: int, backlash: float) -> None:
+        self.command(Cmd.SET_JOINT_BACKLASH, joint=joint, value=backlash)
+
+    def set_joint_motor_offset(self, joint: int, offset: float) -> None:
+        self.command(Cmd.SET_JOINT_MOTOR_OFFSET, joint=joint, value=offset)
+
+    def set_joint_homing(self, joint: int, **keys: Any) -> None:
+        """Homing parameters from [JOINT_n] keys (case-insensitive):
+        HOME, HOME_OFFSET, HOME_SEARCH_VEL, HOME_LATCH_VEL,
+        HOME_FINAL_VEL, HOME_SEQUENCE, HOME_USE_INDEX, HOME_IGNORE_LIMITS,
+        HOME_IS_SHARED, HOME_INDEX_NO_ENCODER_RESET, VOLATILE_HOME,
+        HOME_ABSOLUTE_ENCODER (0, 1, 2), HOME_NO_FINAL_MOVE,
+        HOME_NO_REHOME, HOME_UNLOCK_FIRST."""
+        self.command(Cmd.SET_JOINT_HOMING_PARAMS, joint=joint,
+                     **homing_fields(keys, f"joint {joint}"))
+
+    def _homing_plan(self, joint: int, keys: Mapping[str, Any]) -> None:
+        self.set_joint_homing(joint, **keys)
+
+    def clear_joint_comp(self, joint: int) -> None:
+        self.command(Cmd.CLEAR_JOINT_COMP, joint=joint)
+
+    def set_joint_comp(self, joint: int, entries: Iterable[Sequence[float]]
+                       ) -> None:
+        """Replace the screw compensation table of a joint by ``entries``
+        of (nominal, forward, reverse) with increasing nominal."""
+        self.clear_joint_comp(joint)
+        for k, e in enumerate(entries):
+            nominal, fwd, rev = (float(x) for x in e)
+            try:
+                self.command(Cmd.SET_JOINT_COMP, joint=joint,
+                             comp=(nominal, fwd, rev))
+            except Rejected as r:
+                raise Rejected(r.command, f"entry {k + 1} ({nominal:g}, "
+                               f"{fwd:g}, {rev:g}): {r.reason}") from None
+
+    def load_comp_file(self, joint: int, path: str, type: int = 0) -> int:
+        """Read a compensation file (COMP_FILE, COMP_FILE_TYPE of
+        [JOINT_n]) and send it; returns the number of entries.  A bad
+        file raises before anything is sent, naming the line."""
+        entries = read_comp_file(path, type)
+        self.set_joint_comp(joint, entries)
+        return len(entries)
+
+    def set_axis_limits(self, axis: JointOrAxis, min_limit: float,
+                        max_limit: float) -> None:
+        self.command(Cmd.SET_AXIS_POSITION_LIMITS, axis=_axis(axis),
+                     min_limit=min_limit, max_limit=max_limit)
+
+    def set_axis_max_velocity(self, axis: JointOrAxis, vel: float) -> None:
+        self.command(Cmd.SET_AXIS_VEL_LIMIT, axis=_axis(axis), vel=vel)
+
+    def set_axis_max_acceleration(self, axis: JointOrAxis,
+                                  acc: float) -> None:
+        self.command(Cmd.SET_AXIS_ACC_LIMIT, axis=_axis(axis), acc=acc)
+
+    def set_axis_max_jerk(self, axis: JointOrAxis, jerk: float) -> None:
+        self.command(Cmd.SET_AXIS_JERK_LIMIT, axis=_axis(axis), jerk=jerk)
+
+    def set_vel(self, vel: float, ini_maxvel: Optional[float] = None
+                ) -> None:
+        """Default requested velocity of coordinated moves."""
+        self.command(Cmd.SET_VEL, vel=vel,
+                     ini_maxvel=vel if ini_maxvel is None else ini_maxvel)
+
+    def set_vel_limit(self, vel: float) -> None:
+        """Velocity limit of every coordinated move."""
+        self.command(Cmd.SET_VEL_LIMIT, vel=vel)
+
+    def set_acc(self, acc: float) -> None:
+        """Default acceleration of coordinated moves."""
+        self.command(Cmd.SET_ACC, acc=acc)
+
+    def set_term_cond(self, cond: Union[TermCond, int],
+                      tolerance: float = 0.0) -> None:
+        self.command(Cmd.SET_TERM_COND, ival=int(cond), tolerance=tolerance)
+
+    def set_tool_offset(self, offset: PoseLike) -> None:
+        """The tool offset (9 values or a mapping of axis letters, others
+        0)."""
+        if isinstance(offset, Mapping):
+            v = [0.0] * 9
+            for k, x in offset.items():
+                v[_axis_index(k)] = float(x)
+        else:
+            v = [float(x) for x in offset]
+            if len(v) != 9:
+                raise ValueError("the tool offset needs 9 values")
+        self.command(Cmd.SET_OFFSET, pos=tuple(v))
+
+    def set_profile(self, profile: Union[Profile, str, int]) -> None:
+        """Profile of the free and teleop planners: "trapezoid" or
+        "jerk"."""
+        if isinstance(profile, str):
+            try:
+                profile = Profile[profile.upper()]
+            except KeyError:
+                raise ValueError(f"unknown profile {profile!r} (trapezoid "
+                                 "or jerk)") from None
+        self.command(Cmd.SET_PROFILE, ival=int(profile))
+
+    def set_dout(self, index: int, value: bool) -> None:
+        """Set motion.digital-out-NN now."""
+        self.command(Cmd.SET_DOUT, index=index, ival=1 if value else 0)
+
+    def set_aout(self, index: int, value: float) -> None:
+        """Set motion.analog-out-NN now."""
+        self.command(Cmd.SET_AOUT, index=index, value=value)
+
+    def configure(self, joints: Sequence[Mapping[str, Any]] = (),
+                  axes: Optional[Mapping[str, Mapping[str, Any]]] = None,
+                  traj: Optional[Mapping[str, Any]] = None) -> None:
+        """Send the configuration of a whole machine from INI-like keys.
+
+        ``joints``: one mapping per joint with keys of [JOINT_n]
+        (MIN_LIMIT, MAX_LIMIT, MAX_VELOCITY, MAX_ACCELERATION, MAX_JERK,
+        FERROR, MIN_FERROR, BACKLASH, COMP_FILE, COMP_FILE_TYPE and the
+        homing keys of :meth:`set_joint_homing`; TYPE is accepted and not
+        used); also sets the number of joints.  ``axes``: axis letter ->
+        keys of [AXIS_L] (MIN_LIMIT, MAX_LIMIT, MAX_VELOCITY,
+        MAX_ACCELERATION, MAX_JERK).  ``traj``:
+        keys of [TRAJ] (MAX_LINEAR_VELOCITY or MAX_VELOCITY,
+        DEFAULT_LINEAR_VELOCITY, MAX_LINEAR_ACCELERATION or
+        MAX_ACCELERATION).  Unknown keys raise ValueError before anything
+        is sent."""
+        plans = [(j, _joint_plan(j, keys)) for j, keys in enumerate(joints)]
+        axis_plans = [(_axis(k), _axis_plan(k, v))
+                      for k, v in (axes or {}).items()]
+        traj_plan = _traj_plan(traj or {})
+        if joints:
+            self.set_num_joints(len(joints))
+        for j, plan in plans:
+            for fn, args in plan:
+                getattr(self, fn)(j, *args)
+        for a, plan in axis_plans:
+            for fn, args in plan:
+                getattr(self, fn)(a, *args)
+        for fn, args in traj_plan:
+            getattr(self, fn)(*args)
+
+    def configure_ini(self, path: str) -> None:
+        """Send the motion configuration of an INI file: [KINS]JOINTS,
+        [JOINT_n], [AXIS_L] and [TRAJ] (see :mod:`halsdk.motion.ini`).
+        The whole file is checked first: a bad value raises
+        MotionIniError naming the file and line, and nothing is sent."""
+        from halsdk.motion.ini import read_motion_ini
+        config = read_motion_ini(path)
+        self.configure(config.joints, config.axes, config.traj)
+
+    # ------------------------------------------------------------ status
+
+    def _pull_messages(self) -> None:
+        try:
+            msgs, self._msg_read, lost = self._ch.messages(self._msg_read)
+        except _channel.ChannelError as e:
+            raise MotionError(str(e)) from None
+        if lost:
+            self._pending.append(f"({lost} motion message(s) lost: the "
+                                 "ring overflowed)")
+        self._pending.extend(msgs)
+
+    def status(self) -> Status:
+        """A consistent snapshot of the motion controller."""
+        try:
+            d = self._ch.status()
+        except _channel.ChannelError as e:
+            raise MotionError(str(e)) from None
+        self._pull_messages()
+        return Status.from_dict(d, tuple(self._pending))
+
+    def errors(self) -> list[str]:
+        """The realtime error messages posted since the last call."""
+        self._pull_messages()
+        out, self._pending = self._pending, []
+        return out
+
+    def wait_for(self, predicate: Callable[[Status], bool],
+                 timeout: Optional[float] = None,
+                 what: str = "the condition") -> Status:
+        """Wait until ``predicate(status)`` is true; returns that
+        status."""
+        def cond():
+            st = self.status()
+            return st if predicate(st) else None
+        return self._wait(cond, timeout, what)
+
+    def _wait_raw(self, predicate: Callable[[dict], bool],
+                  timeout: Optional[float], what: str) -> Status:
+        """wait_for() with a predicate on the raw status dict (cheaper
+        per cycle); returns the Status of the cycle it became true."""
+        def cond():
+            try:
+                d = self._ch.status()
+            except _channel.ChannelError as e:
+                raise MotionError(str(e)) from None
+            if predicate(d):
+                self._pull_messages()
+                return Status.from_dict(d, tuple(self._pending))
+            return None
+        return self._wait(cond, timeout, what)
+
+    def wait_inpos(self, timeout: Optional[float] = None) -> Status:
+        """Wait until nothing moves (jogs, homing, coordinated moves)."""
+        return self._wait_raw(
+            lambda d: d["in_position"] and d["queue_depth"] == 0
+            and not d["homing"], timeout, "motion coming to rest")
+
+    def wait_done(self, timeout: Optional[float] = None) -> Status:
+        """Wait until the coordinated queue is empty and everything is at
+        rest; raises MotionError if motion got disabled meanwhile."""
+        def done(d: dict) -> bool:
+            if not d["enabled"]:
+                self._pull_messages()
+                raise MotionError(
+                    "motion was disabled while waiting for the moves to "
+                    "finish" + _because(self._pending))
+            return (d["in_position"] and d["queue_depth"] == 0
+                    and not d["homing"])
+        return self._wait_raw(done, timeout, "the end of the moves")
+
+    def wait_homed(self, joints: Optional[Iterable[int]] = None,
+                   timeout: Optional[float] = None) -> Status:
+        """Wait until the joints (default: all in use) are homed; raises
+        MotionError when homing stops without that."""
+        want = None if joints is None else list(joints)
+        seen_homing = [False]
+
+        def homed(d: dict) -> bool:
+            js = d["joints"][:d["num_joints"]]
+            if want is not None:
+                try:
+                    js = [js[j] for j in want]
+                except IndexError:
+                    raise ValueError(f"wait_homed: joints {want} are not "
+                                     f"all in use (num_joints="
+                                     f"{d['num_joints']})") from None
+            if all(j["flags"] & JOINT_HOMED for j in js):
+                return True
+            if d["homing"]:
+                seen_homing[0] = True
+            elif seen_homing[0] or not d["enabled"]:
+                self._pull_messages()
+                raise MotionError("homing stopped before all joints were "
+                                  "homed" + _because(self._pending))
+            return False
+        return self._wait_raw(homed, timeout, "homing")
+
+    @property
+    def mode(self) -> Mode:
+        return self.status().mode
+
+
+def _because(errors: Sequence[str]) -> str:
+    return (": " + "; ".join(errors)) if errors else ""
+
+
+def _axis(axis: JointOrAxis) -> int:
+    return _axis_index(axis) if isinstance(axis, str) else int(axis)
+
+
+# ---------------------------------------------------------------- INI keys
+
+_HOME_FLOATS = {"home": "home", "home_offset": "home_offset",
+                "home_search_vel": "home_search_vel",
+                "home_latch_vel": "home_latch_vel",
+                "home_final_vel": "home_final_vel"}
+_HOME_BOOLS = {"home_use_index": HOME_USE_INDEX,
+               "home_ignore_limits": HOME_IGNORE_LIMITS,
+               "home_is_shared": HOME_IS_SHARED,
+               "home_unlock_first": HOME_UNLOCK_FIRST,
+               "home_no_rehome": HOME_NO_REHOME,
+               "home_no_final_move": HOME_NO_FINAL_MOVE,
+               "home_index_no_encoder_reset": HOME_INDEX_NO_ENCODER_RESET}
+HOMING_KEYS = (set(_HOME_FLOATS) | set(_HOME_BOOLS) |
+               {"home_sequence", "volatile_home", "home_absolute_encoder"})
+
+
+def _ini_bool(v: Any, key: str) -> bool:
+    if isinstance(v, str):
+        s = v.strip().lower()
+        if s in ("1", "yes", "true", "on"):
+            return True
+        if s in ("0", "no", "false", "off", ""):
+            return False
+        raise ValueError(f"{key} = {v!r} is not a yes/no value")
+    return bool(v)
+
+
+def homing_fields(keys: Mapping[str, Any], where: str = "") -> dict:
+    """[JOINT_n] homing keys -> fields of SET_JOINT_HOMING_PARAMS (the
+    values of an unset key are the reference's defaults; no
+    HOME_SEQUENCE: the joint is not part of "home all")."""
+    out = {"home": 0.0, "home_offset": 0.0, "home_search_vel": 0.0,
+           "home_latch_vel": 0.0, "home_final_vel": -1.0,
+           "home_sequence": HOME_SEQUENCE_NONE, "volatile_home": 0,
+           "home_flags": 0}
+    flags = 0
+    pre = f"{where}: " if where else ""
+
+    def conv(fn, k, v):
+        try:
+            return fn(v)
+        except (TypeError, ValueError):
+            raise ValueError(f"{pre}{k.upper()} = {v!r} is not "
+                             f"{'a number' if fn is float else 'an integer'}"
+                             ) from None
+
+    for k, v in keys.items():
+        key = k.lower()
+        if key in _HOME_FLOATS:
+            out[_HOME_FLOATS[key]] = conv(float, k, v)
+        elif key in _HOME_BOOLS:
+            if _ini_bool(v, pre + key):
+                flags |= _HOME_BOOLS[key]
+        elif key == "home_sequence":
+            out["home_sequence"] = conv(int, k, v)
+        elif key == "volatile_home":
+            out["volatile_home"] = 1 if _ini_bool(v, pre + key) else 0
+        elif key == "home_absolute_encoder":
+            n = conv(int, k, v)
+            if n not in (0, 1, 2):
+                raise ValueError(f"{pre}HOME_ABSOLUTE_ENCODER = {v!r} must "
+                                 "be 0, 1 or 2")
+            if n:
+                flags |= HOME_ABSOLUTE_ENCODER
+            if n == 2:
+                flags |= HOME_NO_FINAL_MOVE
+        else:
+            raise ValueError(f"{pre}unknown homing key {k.upper()}")
+    out["home_flags"] = flags
+    return out
+
+
+def read_comp_file(path: str, type: int = 0) -> list:
+    """Entries (nominal, forward trim, reverse trim) of a compensation file
+    of COMP_FILE_TYPE ``type`` (halsdk.motion.compfile; a malformed file
+    raises CompFileError naming the line)."""
+    from halsdk.motion import compfile
+    return [tuple(e) for e in compfile.read_comp_file(path, type)]
+
+
+def _num(keys: Mapping[str, Any], key: str, where: str) -> float:
+    v = keys[key]
+    try:
+        return float(v)
+    except (TypeError, ValueError):
+        raise ValueError(f"{where}: {key.upper()} = {v!r} is not a "
+                         "number") from None
+
+
+def _lower(keys: Mapping[str, Any]) -> dict:
+    return {k.lower(): v for k, v in keys.items()}
+
+
+def _joint_plan(j: int, keys: Mapping[str, Any]) -> list:
+    where = f"[JOINT_{j}]"
+    k = _lower(keys)
+    known = {"min_limit", "max_limit", "max_velocity", "max_acceleration",
+             "max_jerk", "ferror", "min_ferror", "backlash", "comp_file",
+             "comp_file_type", "type"} | HOMING_KEYS
+    bad = sorted(set(k) - known)
+    if bad:
+        raise ValueError(f"{where}: unknown key(s) "
+                         f"{', '.join(b.upper() for b in bad)}")
+    plan = []
+    if "min_limit" in k or "max_limit" in k:
+        lo = _num(k, "min_limit", where) if "min_limit" in k else -1e99
+        hi = _num(k, "max_limit", where) if "max_limit" in k else 1e99
+        plan.append(("set_joint_limits", (lo, hi)))
+    if "max_velocity" in k:
+        plan.append(("set_joint_max_velocity",
+                     (_num(k, "max_velocity", where),)))
+    if "max_acceleration" in k:
+        plan.append(("set_joint_max_acceleration",
+                     (_num(k, "max_acceleration", where),)))
+    if "max_jerk" in k:
+        plan.append(("set_joint_max_jerk", (_num(k, "max_jerk", where),)))
+    if "ferror" in k or "min_ferror" in k:
+        fe = _num(k, "ferror", where) if "ferror" in k else 1.0
+        mfe = _num(k, "min_ferror", where) if "min_ferror" in k else fe
+        plan.append(("set_joint_ferror", (mfe, fe)))
+    if "backlash" in k:
+        plan.append(("set_joint_backlash", (_num(k, "backlash", where),)))
+    homing = {key: v for key, v in k.items() if key in HOMING_KEYS}
+    if homing:
+        homing_fields(homing, where)        # check before sending
+        plan.append(("_homing_plan", (homing,)))
+    if "comp_file" in k:
+        ctype = k.get("comp_file_type", 0)
+        try:
+            ctype = int(ctype)
+        except (TypeError, ValueError):
+            raise ValueError(f"{where}: COMP_FILE_TYPE = {ctype!r} is not "
+                             "0 or 1") from None
+        entries = read_comp_file(str(k["comp_file"]), ctype)
+        plan.append(("set_joint_comp", (entries,)))
+    return plan
+
+
+def _axis_plan(letter: Any, keys: Mapping[str, Any]) -> list:
+    where = f"[AXIS_{str(letter).upper()}]"
+    k = _lower(keys)
+    known = {"min_limit", "max_limit", "max_velocity", "max_acceleration",
+             "max_jerk"}
+    bad = sorted(set(k) - known)
+    if bad:
+        raise ValueError(f"{where}: unknown key(s) "
+                         f"{', '.join(b.upper() for b in bad)}")
+    plan = []
+    if "min_limit" in k or "max_limit" in k:
+        lo = _num(k, "min_limit", where) if "min_limit" in k else -1e99
+        hi = _num(k, "max_limit", where) if "max_limit" in k else 1e99
+        plan.append(("set_axis_limits", (lo, hi)))
+    if "max_velocity" in k:
+        plan.append(("set_axis_max_velocity",
+                     (_num(k, "max_velocity", where),)))
+    if "max_acceleration" in k:
+        plan.append(("set_axis_max_acceleration",
+                     (_num(k, "max_acceleration", where),)))
+    if "max_jerk" in k:
+        plan.append(("set_axis_max_jerk", (_num(k, "max_jerk", where),)))
+    return plan
+
+
+def _traj_plan(keys: Mapping[str, Any]) -> list:
+    where = "[TRAJ]"
+    k = _lower(keys)
+    known = {"max_linear_velocity", "max_velocity",
+             "default_linear_velocity", "default_velocity",
+             "max_linear_acceleration", "max_acceleration",
+             "default_linear_acceleration", "default_acceleration"}
+    bad = sorted(set(k) - known)
+    if bad:
+        raise ValueError(f"{where}: unknown key(s) "
+                         f"{', '.join(b.upper() for b in bad)}")
+    plan = []
+    for key in ("max_linear_velocity", "max_velocity"):
+        if key in k:
+            plan.append(("set_vel_limit", (_num(k, key, where),)))
+    for key in ("default_linear_velocity", "default_velocity"):
+        if key in k:
+            plan.append(("set_vel", (_num(k, key, where),)))
+    for key in ("max_linear_acceleration", "max_acceleration",
+                "default_linear_acceleration", "default_acceleration"):
+        if key in k:
+            plan.append(("set_acc", (_num(k, key, where),)))
+    return plan
