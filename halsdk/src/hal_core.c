@@ -1315,6 +1315,27 @@ static void delete_items_of(hoff_t comp, hoff_t inst)
     hal_shmem_delete_of(comp, inst);
 }
 
+int hal_owner(int owner_id, const char *what, hoff_t *comp, hoff_t *inst)
+{
+    hal_comp_t *c = hal_comp_by_id(owner_id);
+    *comp = *inst = 0;
+    if (!c) {
+        hal_inst_t *i = hal_inst_by_id(owner_id);
+        if (i) {
+            *inst = SHMOFF(i);
+            c = SHMPTR(i->comp);
+        }
+    }
+    if (!c)
+        return hal_fail(EINVAL, "%s: no component with id %d", what,
+                        owner_id);
+    if (c->pid != getpid())
+        return hal_fail(EPERM, "%s: component '%s' belongs to process %d",
+                        what, c->o.name, c->pid);
+    *comp = SHMOFF(c);
+    return 0;
+}
+
 int hal_inst_delete(const char *name)
 {
     int r = hal_lock();

@@ -321,6 +321,11 @@ int hal_stream_elem_type(long long handle, int index);
 int hal_stream_parse_types(const char *typestring, uint8_t *types,
                            const char *what);
 
+/* lock held: the component (and instance, if owner_id is one) that
+   owner_id names, which must belong to this process; 0 or -errno with
+   the error set, the message starting with what */
+int hal_owner(int owner_id, const char *what, hoff_t *comp, hoff_t *inst);
+
 /* named shared blocks (hal_shmem.c) */
 long long hal_shmem_new(const char *name, int owner_id, long size);
 long long hal_shmem_attach(const char *name);

@@ -109,26 +109,9 @@ long long hal_stream_create(const char *name, int owner_id, int depth,
     if ((r = hal_lock()))
         return r;
     hoff_t comp = 0, inst = 0;
-    hal_comp_t *c = hal_comp_by_id(owner_id);
-    if (!c) {
-        hal_inst_t *i = hal_inst_by_id(owner_id);
-        if (i) {
-            inst = SHMOFF(i);
-            c = SHMPTR(i->comp);
-        }
-    }
-    long long ret;
-    if (!c) {
-        ret = hal_fail(EINVAL, "%s: no component with id %d", what,
-                       owner_id);
+    long long ret = hal_owner(owner_id, what, &comp, &inst);
+    if (ret)
         goto out;
-    }
-    if (c->pid != getpid()) {
-        ret = hal_fail(EPERM, "%s: component '%s' belongs to process %d",
-                       what, c->o.name, c->pid);
-        goto out;
-    }
-    comp = SHMOFF(c);
     if (hal_find(K_STREAM, name)) {
         ret = hal_fail(EEXIST, "duplicate stream name '%s'", name);
         goto out;
