@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import contextlib
 import os
+from collections.abc import Iterator
 
 import pytest
 
@@ -40,6 +42,21 @@ def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
         print("\n/dev/shm check: no HAL instance left behind")
 
 
+@contextlib.contextmanager
+def on_halsdk_path(folder: str) -> Iterator[str]:
+    """Put folder first on HALSDK_PATH while the block runs (the loader
+    searches it before the installed components)."""
+    old = os.environ.get("HALSDK_PATH")
+    os.environ["HALSDK_PATH"] = folder + (os.pathsep + old if old else "")
+    try:
+        yield folder
+    finally:
+        if old is None:
+            os.environ.pop("HALSDK_PATH", None)
+        else:
+            os.environ["HALSDK_PATH"] = old
+
+
 @pytest.fixture(scope="session", autouse=True)
 def component_path(tmp_path_factory: pytest.TempPathFactory) -> str:
     """Build the test components (cached by content) into a folder on
@@ -47,10 +64,5 @@ def component_path(tmp_path_factory: pytest.TempPathFactory) -> str:
     folder = str(tmp_path_factory.mktemp("halsdk-path"))
     for source in TEST_COMPONENTS:
         build_component(os.path.join(COMPONENTS, source), out_dir=folder)
-    old = os.environ.get("HALSDK_PATH")
-    os.environ["HALSDK_PATH"] = folder + (os.pathsep + old if old else "")
-    yield folder
-    if old is None:
-        os.environ.pop("HALSDK_PATH", None)
-    else:
-        os.environ["HALSDK_PATH"] = old
+    with on_halsdk_path(folder):
+        yield folder

@@ -7,6 +7,7 @@ import ctypes
 import os
 
 import pytest
+from conftest import on_halsdk_path
 from test_halcompile import COMPS, halcompile
 
 import halsdk
@@ -22,13 +23,8 @@ def sym_dir(tmp_path_factory: pytest.TempPathFactory):
                       *[os.path.join(COMPS, n + ".comp") for n in MODS],
                       cwd=folder)
     assert proc.returncode == 0, proc.stderr
-    old = os.environ.get("HALSDK_PATH")
-    os.environ["HALSDK_PATH"] = folder + (os.pathsep + old if old else "")
-    yield folder
-    if old is None:
-        os.environ.pop("HALSDK_PATH", None)
-    else:
-        os.environ["HALSDK_PATH"] = old
+    with on_halsdk_path(folder):
+        yield folder
 
 
 def test_a_module_calls_what_another_exported(hal, sym_dir):

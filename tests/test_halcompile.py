@@ -8,6 +8,7 @@ import subprocess
 import sys
 
 import pytest
+from conftest import on_halsdk_path
 
 import halsdk
 from halcompile import CompError, parse, parse_file
@@ -46,13 +47,8 @@ def comp_dir(tmp_path_factory: pytest.TempPathFactory):
                       *[os.path.join(COMPS, n + ".comp") for n in GOOD],
                       cwd=folder)
     assert proc.returncode == 0, proc.stderr
-    old = os.environ.get("HALSDK_PATH")
-    os.environ["HALSDK_PATH"] = folder + (os.pathsep + old if old else "")
-    yield folder
-    if old is None:
-        os.environ.pop("HALSDK_PATH", None)
-    else:
-        os.environ["HALSDK_PATH"] = old
+    with on_halsdk_path(folder):
+        yield folder
 
 
 def names(handles) -> list[str]:

@@ -23,6 +23,7 @@ import sys
 import time
 
 import pytest
+from conftest import on_halsdk_path
 
 from halcompile import parse, parse_file
 from halsdk.build import extension_suffix
@@ -70,13 +71,8 @@ def corpus(tmp_path_factory: pytest.TempPathFactory):
          *[os.path.join(COMPS, n + ".comp") for n in ALL]],
         cwd=folder, env=_env(), capture_output=True, text=True)
     assert proc.returncode == 0, proc.stderr
-    old = os.environ.get("HALSDK_PATH")
-    os.environ["HALSDK_PATH"] = folder + (os.pathsep + old if old else "")
-    yield folder
-    if old is None:
-        os.environ.pop("HALSDK_PATH", None)
-    else:
-        os.environ["HALSDK_PATH"] = old
+    with on_halsdk_path(folder):
+        yield folder
 
 
 def names(handles) -> list[str]:

@@ -6,6 +6,7 @@ from __future__ import annotations
 import os
 
 import pytest
+from conftest import on_halsdk_path
 from test_halcompile import halcompile
 
 from halcompile import CompError, parse
@@ -24,13 +25,8 @@ def cy_dir(tmp_path_factory: pytest.TempPathFactory):
     proc = halcompile("--compile", os.path.join(COMPS, "hccyddt.comp"),
                       os.path.join(COMPS, "hccymulti.comp"), cwd=folder)
     assert proc.returncode == 0, proc.stderr
-    old = os.environ.get("HALSDK_PATH")
-    os.environ["HALSDK_PATH"] = folder + (os.pathsep + old if old else "")
-    yield folder
-    if old is None:
-        os.environ.pop("HALSDK_PATH", None)
-    else:
-        os.environ["HALSDK_PATH"] = old
+    with on_halsdk_path(folder):
+        yield folder
 
 
 def test_modules_are_built(cy_dir):

@@ -13,11 +13,11 @@ from __future__ import annotations
 
 import ctypes
 import math
-import os
 import random
 from pathlib import Path
 
 import pytest
+from conftest import on_halsdk_path
 from test_halcmd import _cli, _env, _shm_left, normalize
 
 import halsdk
@@ -509,14 +509,8 @@ def skewkins_dir(tmp_path: Path):
                       "-Wall -Werror", "skewkins.c",
                       cwd=str(tmp_path))
     assert proc.returncode == 0, proc.stderr
-    old = os.environ.get("HALSDK_PATH")
-    os.environ["HALSDK_PATH"] = str(tmp_path) + (
-        os.pathsep + old if old else "")
-    yield tmp_path
-    if old is None:
-        os.environ.pop("HALSDK_PATH", None)
-    else:
-        os.environ["HALSDK_PATH"] = old
+    with on_halsdk_path(str(tmp_path)):
+        yield tmp_path
 
 
 def test_doc_example_module_builds_and_transforms(hal, skewkins_dir):

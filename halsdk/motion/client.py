@@ -907,6 +907,20 @@ def _lower(keys: Mapping[str, Any]) -> dict:
     return {k.lower(): v for k, v in keys.items()}
 
 
+def _limits_plan(kind: str, k: Mapping[str, Any], where: str) -> list:
+    """Soft limits, velocity, acceleration and jerk of a joint or axis
+    (kind): the calls that send the keys present."""
+    plan = []
+    if "min_limit" in k or "max_limit" in k:
+        lo = _num(k, "min_limit", where) if "min_limit" in k else -1e99
+        hi = _num(k, "max_limit", where) if "max_limit" in k else 1e99
+        plan.append((f"set_{kind}_limits", (lo, hi)))
+    for key in ("max_velocity", "max_acceleration", "max_jerk"):
+        if key in k:
+            plan.append((f"set_{kind}_{key}", (_num(k, key, where),)))
+    return plan
+
+
 def _joint_plan(j: int, keys: Mapping[str, Any]) -> list:
     where = f"[JOINT_{j}]"
     k = _lower(keys)
@@ -917,19 +931,7 @@ def _joint_plan(j: int, keys: Mapping[str, Any]) -> list:
     if bad:
         raise ValueError(f"{where}: unknown key(s) "
                          f"{', '.join(b.upper() for b in bad)}")
-    plan = []
-    if "min_limit" in k or "max_limit" in k:
-        lo = _num(k, "min_limit", where) if "min_limit" in k else -1e99
-        hi = _num(k, "max_limit", where) if "max_limit" in k else 1e99
-        plan.append(("set_joint_limits", (lo, hi)))
-    if "max_velocity" in k:
-        plan.append(("set_joint_max_velocity",
-                     (_num(k, "max_velocity", where),)))
-    if "max_acceleration" in k:
-        plan.append(("set_joint_max_acceleration",
-                     (_num(k, "max_acceleration", where),)))
-    if "max_jerk" in k:
-        plan.append(("set_joint_max_jerk", (_num(k, "max_jerk", where),)))
+    plan = _limits_plan("joint", k, where)
     if "ferror" in k or "min_ferror" in k:
         fe = _num(k, "ferror", where) if "ferror" in k else 1.0
         mfe = _num(k, "min_ferror", where) if "min_ferror" in k else fe
@@ -961,20 +963,7 @@ def _axis_plan(letter: Any, keys: Mapping[str, Any]) -> list:
     if bad:
         raise ValueError(f"{where}: unknown key(s) "
                          f"{', '.join(b.upper() for b in bad)}")
-    plan = []
-    if "min_limit" in k or "max_limit" in k:
-        lo = _num(k, "min_limit", where) if "min_limit" in k else -1e99
-        hi = _num(k, "max_limit", where) if "max_limit" in k else 1e99
-        plan.append(("set_axis_limits", (lo, hi)))
-    if "max_velocity" in k:
-        plan.append(("set_axis_max_velocity",
-                     (_num(k, "max_velocity", where),)))
-    if "max_acceleration" in k:
-        plan.append(("set_axis_max_acceleration",
-                     (_num(k, "max_acceleration", where),)))
-    if "max_jerk" in k:
-        plan.append(("set_axis_max_jerk", (_num(k, "max_jerk", where),)))
-    return plan
+    return _limits_plan("axis", k, where)
 
 
 def _traj_plan(keys: Mapping[str, Any]) -> list:
