@@ -111,12 +111,21 @@ def private_instance_name() -> str:
     return f"pytest-{os.getpid()}-{next(_counter)}"
 
 
+def pytest_configure(config: pytest.Config) -> None:
+    config.addinivalue_line(
+        "markers", "hal_size(nbytes): size of the test's private HAL "
+        "instance (the hal fixture), when the default is too small")
+
+
 @pytest.fixture
-def hal(monkeypatch: pytest.MonkeyPatch):
-    """A private HAL instance hosted by the test process."""
+def hal(monkeypatch: pytest.MonkeyPatch, request: pytest.FixtureRequest):
+    """A private HAL instance hosted by the test process (its size:
+    ``@pytest.mark.hal_size(nbytes)``, default TEST_INSTANCE_SIZE)."""
     name = private_instance_name()
     monkeypatch.setenv("HALSDK_INSTANCE", name)
-    h = TestHal(name, create=True, size=TEST_INSTANCE_SIZE)
+    marker = request.node.get_closest_marker("hal_size")
+    size = marker.args[0] if marker else TEST_INSTANCE_SIZE
+    h = TestHal(name, create=True, size=size)
     _created.append(halsdk.instance.shm_name(name))
     try:
         yield h
