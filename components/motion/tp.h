@@ -3,8 +3,8 @@
  * planner module.
  *
  * The coordinated-mode planner is a separate, replaceable realtime module
- * (tpmod is the one shipped: exact stop between moves; issue 7 brings a
- * blending one with the same interface).  It exports one table, the
+ * (tpmod is the one shipped: blending look-ahead planner, see tpmod.c and
+ * docs/motion.rst "How the planner blends").  It exports one table, the
  * symbol HALSDK_TP_SYMBOL, that motmod looks up when it loads.
  *
  * The planner works in Cartesian space: the nine axes of an EmcPose, in
@@ -24,7 +24,16 @@
 #include "emcpose.h"
 
 #define HALSDK_TP_SYMBOL "halsdk_tp_api"
-#define HALSDK_TP_VERSION 1
+#define HALSDK_TP_VERSION 2
+
+/* Version 2 (issue 7) appended, never reordered: tp_move_t gained
+   cam_tolerance and the spindle-synchronized fields, tp_inputs_t the feed
+   controls and per-spindle inputs (used when the matching TP_IN_* bit is
+   set in have, so a caller that zeroes the struct keeps v1 behaviour),
+   tp_hooks_t the spindle hooks, tp_state_t more reports, and the table
+   reset() and add_rigid_tap().  Every new struct field
+   is zero-safe: a zeroed field means "not used". */
+#define TP_MAX_SPINDLES 8
 
 /* kinds of move (the numbers are those of the reference's motion types,
    shown on motion.motion-type) */
@@ -55,6 +64,16 @@ enum tp_term_cond {
 #define TP_PROBE_AWAY           0x0002  /* trip when the input goes false
                                            (G38.4/.5) */
 
+/* kinds of spindle synchronization (tp_move_t.sync) */
+enum tp_sync {
+    TP_SYNC_NONE = 0,           /* ordinary move */
+    TP_SYNC_POSITION = 1,       /* G33: distance = pitch x spindle revs
+                                   since the start (waits for at-speed and
+                                   the index before starting) */
+    TP_SYNC_VELOCITY = 2        /* G95-like: path velocity = pitch x
+                                   spindle speed (no index wait) */
+};
+
 /* what every queued move carries besides its geometry */
 typedef struct {
     int id;                     /* motion id (from the command) */
@@ -65,10 +84,38 @@ typedef struct {
     double acc;                 /* path acceleration limit, > 0 */
     double jerk;                /* path jerk limit; 0: none */
     int term_cond;              /* enum tp_term_cond */
-    double tolerance;           /* blend tolerance; 0: as fast as the
+    double tolerance;           /* blend tolerance (G64 P): the largest
+                                   distance of the path from the
+                                   programmed one; 0: as fast as the
                                    limits allow */
     unsigned flags;             /* TP_MOVE_* */
+    /* --- version 2 --- */
+    double cam_tolerance;       /* G64 Q: consecutive lines whose
+                                   vertices stay within this distance of
+                                   the merged line are run as one line
+                                   (term_cond TP_TERM_BLEND only); 0: no
+                                   merging */
+    int sync;                   /* enum tp_sync */
+    int spindle;                /* the spindle a synchronized move
+                                   follows, 0..TP_MAX_SPINDLES-1 */
+    double pitch;               /* synchronized moves: path distance per
+                                   spindle revolution (> 0) */
 } tp_move_t;
+
+/* one spindle's inputs (version 2) */
+typedef struct {
+    double revs;                /* spindle.N.revs */
+    double speed;               /* spindle.N.speed-in, rev/s */
+    int at_speed;               /* spindle.N.at-speed */
+    int index_enable;           /* spindle.N.index-enable as read back:
+                                   the planner arms it through the
+                                   index_enable hook and waits for it to
+                                   go false (the index was seen) */
+} tp_spindle_in_t;
+
+/* bits of tp_inputs_t.have: which version-2 fields the caller filled */
+#define TP_IN_FEED      0x0001  /* feed_hold, feed_inhibit, adaptive_feed */
+#define TP_IN_SPINDLES  0x0002  /* spindle[] */
 
 /* inputs of one planner cycle (read from motmod's pins) */
 typedef struct {
@@ -76,12 +123,34 @@ typedef struct {
     double spindle_revs;        /* spindle.0.revs (synchronized moves) */
     double spindle_speed;       /* spindle.0.speed-in, rev/s */
     int spindle_at_speed;       /* spindle.0.at-speed */
+    /* --- version 2 --- */
+    unsigned have;              /* TP_IN_* bits; 0: the v1 fields only
+                                   (feed hold etc. folded into set_scale by
+                                   the caller; spindle 0 from the fields
+                                   above, no index handshake) */
+    int feed_hold;              /* motion.feed-hold: feed moves stop along
+                                   the path (not TP_MOVE_NO_FEED_HOLD
+                                   ones, not rapids) */
+    int feed_inhibit;           /* motion.feed-inhibit: every move stops
+                                   along the path; a synchronized move
+                                   does not start */
+    double adaptive_feed;       /* motion.adaptive-feed: multiplies the
+                                   feed scale; clamped to 0..1 */
+    tp_spindle_in_t spindle[TP_MAX_SPINDLES];
 } tp_inputs_t;
 
 /* outputs the planner fires at the start of a move (synchronized I/O) */
 typedef struct {
     void (*set_dout)(int index, int value);
     void (*set_aout)(int index, double value);
+    /* --- version 2 (NULL: not available; G33 then starts without the
+       index, rigid tapping is refused) --- */
+    /* set spindle.N.index-enable true (the planner then waits for it to
+       read back false in tp_inputs_t.spindle[N].index_enable) */
+    void (*index_enable)(int spindle);
+    /* rigid tapping: reverse = 1: turn spindle N the other way than
+       commanded; 0: restore the commanded direction */
+    void (*spindle_reverse)(int spindle, int reverse);
 } tp_hooks_t;
 
 /* what run_cycle reports besides the position */
@@ -98,6 +167,19 @@ typedef struct {
     int done;                   /* no move queued or running and at rest */
     int paused;                 /* paused and at rest */
     int probing;                /* a probe move runs */
+    /* --- version 2 --- */
+    double requested_vel;       /* the path velocity the running move asks
+                                   for now, overrides included */
+    int active_moves;           /* moves the look-ahead is blending
+                                   through now (the running one included;
+                                   for motion.active-tc / tc.N) */
+    int waiting;                /* 1: a synchronized move waits for the
+                                   spindle at-speed, 2: for the index,
+                                   0: not waiting */
+    int spindle_sync;           /* a spindle-synchronized move runs */
+    int rigid_tap_reversed;     /* the spindle_reverse hook is active */
+    double feed_scale;          /* the effective feed scale now (feed
+                                   scale x adaptive feed, 0 while held) */
 } tp_state_t;
 
 typedef struct {
@@ -176,6 +258,19 @@ typedef struct {
        reports it as a motion error (e.g. a probe move that ended without
        contact, or a probe already tripped when its move starts) */
     const char *(*take_error)(void);
+
+    /* --- version 2 --- */
+    /* drop every queued move and all motion at once (no deceleration:
+       for motion being disabled): the planner is at rest where its last
+       commanded position was, paused/step/abort flags and pending
+       synchronized outputs cleared; probe result kept */
+    void (*reset)(void);
+    /* rigid tapping (G33.1): a line to end following spindle
+       move->spindle with move->pitch per rev; at end the spindle is
+       reversed (hook), the tool follows it back to the start, the
+       direction is restored, and the tool returns exactly to the start */
+    int (*add_rigid_tap)(const EmcPose *end, const tp_move_t *move,
+                         char *why, int whylen);
 } halsdk_tp_api_t;
 
 #endif
