@@ -29,7 +29,8 @@ DT = 0.001                      # servo period of the tests (s)
 
 AXES = "x y z a b c u v w".split()
 MAX_JOINTS, MAX_AXES, REASON_LEN, MSG_LEN, MSG_RING = 16, 9, 200, 200, 32
-MAGIC, VERSION = 0x4D4F5443, 1
+MAGIC, VERSION = 0x4D4F5443, 2
+MAX_AIO, MAX_SPINDLES, QUEUE_SIZE = 64, 8, 1024
 
 (ABORT, FREE, TELEOP, COORD, ENABLE, DISABLE, ENABLE_AMPLIFIER,
  DISABLE_AMPLIFIER, ACTIVATE_JOINT, DEACTIVATE_JOINT, PAUSE, RESUME, STEP,
@@ -70,7 +71,17 @@ class Command(C.Structure):
                    "home_final_vel".split()]
                 + [("home_sequence", C.c_int32), ("volatile_home", C.c_int32),
                    ("home_flags", C.c_uint32), ("pad0", C.c_int32),
-                   ("reserved", C.c_double * 8)])
+                   ("line", C.c_int32), ("epoch", C.c_uint32),
+                   ("sync", C.c_int32), ("pad1", C.c_int32),
+                   ("pitch", C.c_double), ("reserved", C.c_double * 5)])
+
+
+class SpindleStatus(C.Structure):
+    _fields_ = ([(n, C.c_double) for n in
+                 "speed speed_in revs orient_angle css_factor".split()]
+                + [(n, C.c_int32) for n in
+                   "on direction brake locked orient_state orient_fault "
+                   "at_speed inhibit amp_fault pad0".split()])
 
 
 class JointStatus(C.Structure):
@@ -109,8 +120,18 @@ class Status(C.Structure):
                    ("probed_pos", EmcPose), ("tool_offset", EmcPose),
                    ("dout", C.c_uint64), ("din", C.c_uint64),
                    ("joint", JointStatus * MAX_JOINTS),
-                   ("axis", AxisStatus * MAX_AXES),
-                   ("reserved", C.c_double * 32)])
+                   ("axis", AxisStatus * MAX_AXES)]
+                + [(n, C.c_int32) for n in
+                   "program_line feed_hold_enabled adaptive_enabled "
+                   "feed_hold feed_inhibit queue_taken".split()]
+                + [("queue_err_count", C.c_uint32), ("pad1", C.c_int32)]
+                + [(n, C.c_double) for n in
+                   "adaptive_feed feed_upm linear_units".split()]
+                + [("ain", C.c_double * MAX_AIO),
+                   ("aout", C.c_double * MAX_AIO),
+                   ("spindle", SpindleStatus * MAX_SPINDLES),
+                   ("spindle_wait", C.c_int32), ("queue_held", C.c_int32),
+                   ("reserved", C.c_double * 15)])
 
 
 class Msg(C.Structure):
@@ -126,7 +147,12 @@ class Channel(C.Structure):
                 ("command", Command),
                 ("status_seq", C.c_uint32), ("pad0", C.c_int32),
                 ("status", Status),
-                ("msg_count", C.c_uint64), ("msgs", Msg * MSG_RING)]
+                ("msg_count", C.c_uint64), ("msgs", Msg * MSG_RING),
+                ("q_head", C.c_uint32), ("q_tail", C.c_uint32),
+                ("q_err_count", C.c_uint32), ("q_err_cmd", C.c_int32),
+                ("q_err_id", C.c_int32), ("q_err_line", C.c_int32),
+                ("q_err_reason", C.c_char * REASON_LEN),
+                ("queue", Command * QUEUE_SIZE)]
 
 
 class Machine:
@@ -396,7 +422,7 @@ def test_rejections_have_reasons(m):
         (dict(cmd=SET_TERM_COND, ival=3), "3 is not a termination "
          "condition"),
         (dict(cmd=OVERRIDE_LIMITS, ival=2), "OVERRIDE_LIMITS takes 1"),
-        (dict(cmd=120), "command 120 is reserved"),
+        (dict(cmd=130), "command 130 is reserved"),
         (dict(cmd=999), "unknown command code 999"),
         (dict(cmd=UNHOME, joint=-7), "UNHOME: joint -7"),
     ]

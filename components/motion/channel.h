@@ -36,7 +36,10 @@
  * reads cmd_seq with acquire, copies the record, checks it and either
  * runs it or rejects it, then writes echo_status, echo_reason and finally
  * echo_seq = the number it took.  It takes at most one command per
- * cycle.
+ * cycle.  One exception: a feed move (SET_LINE / SET_CIRCLE of type feed
+ * or arc, SPINDLE_SYNC_LINE, RIGID_TAP) that arrives while a spindle
+ * start or speed change is pending is left in the mailbox, unanswered,
+ * until the planner has run out and every turning spindle is at speed.
  *
  * echo_status:
  *  MOT_ECHO_DONE      the command has been carried out completely
@@ -103,6 +106,40 @@
  * off, sets status.error and posts a message; ENABLE clears status.error.
  *
  * ---------------------------------------------------------------------
+ * The move queue (ring of queued records)
+ * ---------------------------------------------------------------------
+ * The command mailbox takes one command per servo cycle and answers each
+ * one; a part program needs several moves per cycle.  Moves and what must
+ * keep its order with them go through a ring of MOT_QUEUE_SIZE command
+ * records instead, with no answer per record:
+ *     SET_LINE, SET_CIRCLE, PROBE, SPINDLE_SYNC_LINE, RIGID_TAP,
+ *     SET_DOUT / SET_AOUT (sync 1: at the start of the next move; 0: when
+ *     the handler takes the record), SET_TERM_COND, SET_VEL, SET_ACC,
+ *     SET_VEL_LIMIT, SET_FEED_HOLD_ENABLE, SET_ADAPTIVE_FEED_ENABLE.
+ * Other codes in the ring are rejected.  The same records are accepted
+ * by the mailbox too (then answered one by one).
+ *
+ * q_head counts the records ever written (only the client writes it),
+ * q_tail those the handler took (only the handler writes it); both wrap
+ * at 2^32, the ring holds q_head - q_tail <= MOT_QUEUE_SIZE records and
+ * record n lives in queue[n % MOT_QUEUE_SIZE].  The writer must hold the
+ * client lock (one producer at a time).  Writing:
+ *     wait until q_head - q_tail (acquire) < MOT_QUEUE_SIZE;
+ *     fill queue[q_head % MOT_QUEUE_SIZE] with epoch = q_err_count as
+ *     last read; release store q_head + 1.
+ * Every servo cycle, after the mailbox, the handler takes records while
+ * the planner has room for a move (up to MOT_QUEUE_BURST per cycle),
+ * and publishes q_tail with a release store.  A record that is refused
+ * stops the queue: the handler writes q_err_cmd, q_err_id, q_err_line
+ * and q_err_reason, posts the reason as an error message, then
+ * increments q_err_count (release).  From then on every record whose
+ * epoch is not the new q_err_count is dropped unread (the rest of the
+ * program that was already written); a client that sees q_err_count
+ * change reports the error and writes new records with the new epoch.
+ * ABORT and DISABLE (and every fault) drop the records not yet taken.
+ * The moves the planner already has run on (ABORT stops them).
+ *
+ * ---------------------------------------------------------------------
  * Versioning
  * ---------------------------------------------------------------------
  * magic, version and size are written once by motmod before anything
@@ -117,7 +154,7 @@
 
 #define MOT_CHANNEL_NAME    "motmod.channel"
 #define MOT_CHANNEL_MAGIC   0x4d4f5443u     /* "MOTC" */
-#define MOT_CHANNEL_VERSION 1
+#define MOT_CHANNEL_VERSION 2
 
 #define MOT_MAX_JOINTS      16
 #define MOT_MAX_AXES        9       /* X Y Z A B C U V W */
@@ -128,6 +165,8 @@
 #define MOT_REASON_LEN      200
 #define MOT_MSG_LEN         200
 #define MOT_MSG_RING        32
+#define MOT_QUEUE_SIZE      1024    /* records of the move queue ring */
+#define MOT_QUEUE_BURST     16      /* records taken per cycle, at most */
 
 /* command codes (mot_command_t.cmd); the numbers are part of the
    protocol and never change */
@@ -222,9 +261,43 @@ enum mot_cmd {
     MOT_CMD_SET_DOUT = 72,          /* index, ival 0/1: now */
     MOT_CMD_SET_AOUT = 73,          /* index, value: now */
 
-    /* 100..149: reserved for issue 7 (spindles, synchronized I/O,
-       adaptive feed, feed hold ...) */
-    MOT_CMD_RESERVED_FIRST = 100,
+    /* feed control and units */
+    MOT_CMD_SET_FEED_HOLD_ENABLE = 100,     /* ival 1/0: motion.feed-hold
+                                               applies (M53 P1) or not;
+                                               default 1 */
+    MOT_CMD_SET_ADAPTIVE_FEED_ENABLE = 101, /* ival 1/0: motion.adaptive-
+                                               feed applies (M52 P1) or
+                                               not; default 0 */
+    MOT_CMD_SET_LINEAR_UNITS = 102,         /* value = millimetres per
+                                               machine length unit (1 for
+                                               mm, 25.4 for inch); 0:
+                                               unknown */
+
+    /* spindles: index = spindle number (0 .. num_spindles-1) */
+    MOT_CMD_SPINDLE_ON = 110,       /* vel = speed in rpm, the sign gives
+                                       the direction (> 0 forward);
+                                       optional CSS: value = surface speed
+                                       (units/min) > 0, ival = the axis
+                                       the radius is measured on (0 X),
+                                       offset = the maximum rpm */
+    MOT_CMD_SPINDLE_OFF = 111,
+    MOT_CMD_SPINDLE_INCREASE = 112, /* value = rpm step (0: 10 %) */
+    MOT_CMD_SPINDLE_DECREASE = 113,
+    MOT_CMD_SPINDLE_ORIENT = 114,   /* value = angle (degrees), ival =
+                                       mode (orient-mode pin) */
+    MOT_CMD_SPINDLE_BRAKE_ENGAGE = 115,
+    MOT_CMD_SPINDLE_BRAKE_RELEASE = 116,
+
+    /* spindle-synchronized moves (queued like SET_LINE; they need the
+       spindle on): pos, id, vel (the velocity limit of the move),
+       ini_maxvel, acc, pitch = travel per revolution (> 0), index =
+       spindle */
+    MOT_CMD_SPINDLE_SYNC_LINE = 120,    /* G33: a threading move */
+    MOT_CMD_RIGID_TAP = 121,            /* G33.1: in to pos, reverse the
+                                           spindle, out to the start */
+
+    /* 122..149: reserved */
+    MOT_CMD_RESERVED_FIRST = 122,
     MOT_CMD_RESERVED_LAST = 149,
 
     MOT_CMD_LAST = 150              /* all codes are < this */
@@ -312,7 +385,17 @@ typedef struct {
     int32_t volatile_home;
     uint32_t home_flags;        /* HOME_* of homing.h */
     int32_t pad0;
-    double reserved[8];         /* zero; for issue 7 */
+    int32_t line;               /* program line of a move (shown on
+                                   motion.program-line while it runs) */
+    uint32_t epoch;             /* queued records: the queue's error
+                                   count q_err_count the client had seen
+                                   when it wrote the record */
+    int32_t sync;               /* SET_DOUT / SET_AOUT: 0 now, 1 when the
+                                   next queued move starts */
+    int32_t pad1;
+    double pitch;               /* spindle-synchronized moves: travel per
+                                   spindle revolution */
+    double reserved[5];         /* zero */
 } mot_command_t;
 
 /* one joint in the status snapshot */
@@ -358,6 +441,35 @@ typedef struct {
     int32_t teleop_active;      /* the teleop planner moves */
     int32_t jog_active;
 } mot_axis_status_t;
+
+/* one spindle */
+typedef struct {
+    double speed;               /* commanded speed, rpm, signed
+                                   (spindle.N.speed-out) */
+    double speed_in;            /* spindle.N.speed-in, rev/s */
+    double revs;                /* spindle.N.revs */
+    double orient_angle;
+    double css_factor;          /* CSS surface speed, 0: off */
+    int32_t on;                 /* spindle.N.on */
+    int32_t direction;          /* 1 forward, -1 reverse, 0 off */
+    int32_t brake;
+    int32_t locked;             /* oriented and held */
+    int32_t orient_state;       /* enum mot_orient_state */
+    int32_t orient_fault;       /* last orient-fault code seen */
+    int32_t at_speed;
+    int32_t inhibit;
+    int32_t amp_fault;
+    int32_t pad0;
+} mot_spindle_status_t;
+
+/* mot_spindle_status_t.orient_state */
+enum mot_orient_state {
+    MOT_ORIENT_NONE = 0,
+    MOT_ORIENT_RUNNING = 1,     /* spindle.N.orient true, waiting for
+                                   is-oriented */
+    MOT_ORIENT_DONE = 2,        /* is-oriented came: locked, brake on */
+    MOT_ORIENT_FAULT = 3        /* orient-fault was not 0 */
+};
 
 typedef struct {
     uint64_t heartbeat;         /* servo cycles run by motion-controller */
@@ -407,7 +519,27 @@ typedef struct {
     uint64_t din;               /* motion.digital-in-NN bits */
     mot_joint_status_t joint[MOT_MAX_JOINTS];
     mot_axis_status_t axis[MOT_MAX_AXES];
-    double reserved[32];        /* zero; for issue 7 (spindles) */
+    /* issue 7 */
+    int32_t program_line;       /* motion.program-line */
+    int32_t feed_hold_enabled;  /* SET_FEED_HOLD_ENABLE */
+    int32_t adaptive_enabled;   /* SET_ADAPTIVE_FEED_ENABLE */
+    int32_t feed_hold;          /* motion.feed-hold is in force */
+    int32_t feed_inhibit;       /* motion.feed-inhibit */
+    int32_t queue_taken;        /* q_tail: queued records taken */
+    uint32_t queue_err_count;   /* q_err_count */
+    int32_t pad1;
+    double adaptive_feed;       /* motion.adaptive-feed */
+    double feed_upm;            /* motion.feed-upm */
+    double linear_units;        /* mm per length unit (0: unknown) */
+    double ain[MOT_MAX_AIO];    /* motion.analog-in-NN (num_aio used) */
+    double aout[MOT_MAX_AIO];   /* motion.analog-out-NN */
+    mot_spindle_status_t spindle[MOT_MAX_SPINDLES];
+    int32_t spindle_wait;       /* the planner waits for a spindle: 1
+                                   at-speed, 2 the index (tp_state_t
+                                   waiting) */
+    int32_t queue_held;         /* motmod holds the next feed move until
+                                   the spindles are at speed */
+    double reserved[15];        /* zero */
 } mot_status_t;
 
 typedef struct {
@@ -438,6 +570,16 @@ typedef struct {
     /* error messages: realtime -> everyone */
     volatile uint64_t msg_count;
     mot_msg_t msgs[MOT_MSG_RING];
+
+    /* the move queue ring: client -> handler (see "The move queue") */
+    volatile uint32_t q_head;       /* records ever written (client) */
+    volatile uint32_t q_tail;       /* records ever taken (handler) */
+    volatile uint32_t q_err_count;  /* queued records rejected so far */
+    int32_t q_err_cmd;              /* the last rejected record: code, */
+    int32_t q_err_id;               /* id, */
+    int32_t q_err_line;             /* line */
+    char q_err_reason[MOT_REASON_LEN];  /* and why */
+    mot_command_t queue[MOT_QUEUE_SIZE];
 } mot_channel_t;
 
 #endif

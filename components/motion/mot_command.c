@@ -33,7 +33,18 @@
  *    ini_maxvel 0 means the SET_VEL_LIMIT value, acc 0 the SET_ACC value
  *    (both must then have been set);
  *  - the configuration commands may be sent at any time, except
- *    SET_NUM_JOINTS (needs motion disabled).
+ *    SET_NUM_JOINTS (needs motion disabled);
+ *  - after the mailbox, the move queue of the channel is drained into
+ *    the planner (channel.h "The move queue"): up to MOT_QUEUE_BURST
+ *    records a cycle while the planner has room; the first refused record
+ *    stops the queue and drops the records written after it;
+ *  - a spindle start or speed change makes the next feed move wait until
+ *    the planner has run out and the turning spindles are at speed (the
+ *    queue, or the mailbox, holds it); SPINDLE_OFF of the last turning
+ *    spindle cancels the wait;
+ *  - SPINDLE_ON and SPINDLE_ORIENT need motion enabled; DISABLE and
+ *    faults stop the spindles; the brake is engaged by SPINDLE_OFF, by a
+ *    finished orient and by BRAKE_ENGAGE (refused while turning).
  */
 #include "rtapi.h"
 #include "rtapi_math.h"
@@ -79,6 +90,24 @@ static const char *cmd_name(int c)
     case MOT_CMD_TELEOP: return "TELEOP";
     case MOT_CMD_COORD: return "COORD";
     case MOT_CMD_FREE: return "FREE";
+    case MOT_CMD_SET_DOUT: return "SET_DOUT";
+    case MOT_CMD_SET_AOUT: return "SET_AOUT";
+    case MOT_CMD_SET_TERM_COND: return "SET_TERM_COND";
+    case MOT_CMD_SET_VEL: return "SET_VEL";
+    case MOT_CMD_SET_ACC: return "SET_ACC";
+    case MOT_CMD_SET_VEL_LIMIT: return "SET_VEL_LIMIT";
+    case MOT_CMD_SET_FEED_HOLD_ENABLE: return "SET_FEED_HOLD_ENABLE";
+    case MOT_CMD_SET_ADAPTIVE_FEED_ENABLE: return "SET_ADAPTIVE_FEED_ENABLE";
+    case MOT_CMD_SET_LINEAR_UNITS: return "SET_LINEAR_UNITS";
+    case MOT_CMD_SPINDLE_ON: return "SPINDLE_ON";
+    case MOT_CMD_SPINDLE_OFF: return "SPINDLE_OFF";
+    case MOT_CMD_SPINDLE_INCREASE: return "SPINDLE_INCREASE";
+    case MOT_CMD_SPINDLE_DECREASE: return "SPINDLE_DECREASE";
+    case MOT_CMD_SPINDLE_ORIENT: return "SPINDLE_ORIENT";
+    case MOT_CMD_SPINDLE_BRAKE_ENGAGE: return "SPINDLE_BRAKE_ENGAGE";
+    case MOT_CMD_SPINDLE_BRAKE_RELEASE: return "SPINDLE_BRAKE_RELEASE";
+    case MOT_CMD_SPINDLE_SYNC_LINE: return "SPINDLE_SYNC_LINE";
+    case MOT_CMD_RIGID_TAP: return "RIGID_TAP";
     default: return "the command";
     }
 }
@@ -406,6 +435,15 @@ static int cmd_jog(const mot_command_t *c)
                   "-1 (teleop mode)", cmd_name(c->cmd));
 }
 
+/* ---- spindles ---- */
+static int bad_spindle(int n)
+{
+    if (n < 0 || n >= mot->num_spindles)
+        return reject("spindle %d does not exist (num_spindles=%d)", n,
+                      mot->num_spindles);
+    return 0;
+}
+
 /* ---- coordinated moves ---- */
 static int move_args(const mot_command_t *c, tp_move_t *m)
 {
@@ -430,7 +468,23 @@ static int move_args(const mot_command_t *c, tp_move_t *m)
     m->jerk = c->jerk;
     m->term_cond = mot->term_cond;
     m->tolerance = mot->tolerance;
+    m->cam_tolerance = mot->cam_tolerance;
     m->flags = (unsigned)c->ival;
+    if (c->cmd == MOT_CMD_PROBE)
+        m->flags = 0;
+    if (c->cmd == MOT_CMD_SPINDLE_SYNC_LINE || c->cmd == MOT_CMD_RIGID_TAP) {
+        int n = c->index;
+        if ((r = bad_spindle(n)))
+            return r;
+        if ((r = bad_positive("pitch", c->pitch)))
+            return r;
+        if (!mot->spindle[n].on || mot->spindle[n].speed == 0)
+            return reject("%s needs spindle %d turning (SPINDLE_ON first)",
+                          name, n);
+        m->sync = TP_SYNC_POSITION;
+        m->spindle = n;
+        m->pitch = c->pitch;
+    }
     if (m->ini_maxvel == 0)
         m->ini_maxvel = mot->vel_limit;
     if (m->acc == 0)
@@ -445,7 +499,7 @@ static int move_args(const mot_command_t *c, tp_move_t *m)
     if (c->motion_type < 0 || c->motion_type > MOT_MOTION_INDEXROTARY)
         return reject("motion type %d is not one of 0..6", c->motion_type);
     /* the end point must be inside the axes' limits (when they apply) */
-    if (mot_all_homed()) {
+    if (mot->all_homed_c) {
         int i;
         for (i = 0; i < MOT_MAX_AXES; i++) {
             mot_axis_t *a = &mot->axis[i];
@@ -479,16 +533,24 @@ static int cmd_move(const mot_command_t *c)
             return reject("SET_CIRCLE: the normal must not be (0, 0, 0)");
         r = mot->tp->add_circle(&c->pos, &c->center, &c->normal, c->turn,
                                 &m, w, sizeof(w));
-    } else {
+    } else if (c->cmd == MOT_CMD_PROBE) {
         if (mot->probe_tripped)
             return reject("PROBE: the probe flag is still set (send "
                           "CLEAR_PROBE_FLAG first)");
         r = mot->tp->add_probe(&c->pos, &m, c->ival, w, sizeof(w));
+    } else if (c->cmd == MOT_CMD_SPINDLE_SYNC_LINE) {
+        r = mot->tp->add_line(&c->pos, &m, w, sizeof(w));
+    } else {
+        if (!mot->tp->add_rigid_tap)
+            return reject("RIGID_TAP: the trajectory planner cannot do "
+                          "rigid tapping");
+        r = mot->tp->add_rigid_tap(&c->pos, &m, w, sizeof(w));
     }
     if (r < 0)
         return reject("%s: %s", cmd_name(c->cmd),
                       w[0] ? w : "the trajectory planner refused it");
     mot->tp_done = 0;
+    mot_line_push(c->id, c->line, c->vel);
     return MOT_ECHO_ACCEPTED;
 }
 
@@ -578,6 +640,141 @@ static int cmd_unhome(const mot_command_t *c)
     return MOT_ECHO_DONE;
 }
 
+static int any_spindle_on(void)
+{
+    int i;
+    for (i = 0; i < mot->num_spindles; i++)
+        if (mot->spindle[i].on && mot->spindle[i].speed != 0)
+            return 1;
+    return 0;
+}
+
+/* a new speed or direction: the next feed move waits for at-speed */
+static void spindle_changed(mot_spindle_t *sp, double old)
+{
+    if (sp->speed != old)
+        mot->wait_at_speed = 1;
+}
+
+static int cmd_spindle(const mot_command_t *c)
+{
+    const char *name = cmd_name(c->cmd);
+    mot_spindle_t *sp;
+    int r, n = c->index;
+    double old, step;
+
+    if ((r = bad_spindle(n)))
+        return r;
+    sp = &mot->spindle[n];
+    old = sp->on ? sp->speed : 0.0;
+    switch (c->cmd) {
+    case MOT_CMD_SPINDLE_ON:
+        if (!mot->enabled)
+            return reject("SPINDLE_ON needs motion enabled");
+        if ((r = bad_pos("spindle speed", c->vel)))
+            return r;
+        if (c->value != 0) {
+            if ((r = bad_positive("CSS surface speed", c->value))
+                || (r = bad_nonneg("CSS maximum speed", c->offset)))
+                return r;
+            if (c->ival < 0 || c->ival >= MOT_MAX_AXES)
+                return reject("SPINDLE_ON: CSS axis %d does not exist (axes "
+                              "are 0..8 for X..W)", c->ival);
+        }
+        if (*mot->sp[n].amp_fault_in)
+            return reject("SPINDLE_ON: spindle %d has an amplifier fault "
+                          "(spindle.%d.amp-fault-in is true)", n, n);
+        sp->speed = c->vel;
+        sp->css_factor = c->value;
+        sp->css_axis = c->ival;
+        sp->css_max = c->offset;
+        sp->on = 1;
+        sp->brake = 0;
+        sp->orient_state = MOT_ORIENT_NONE;
+        sp->amp_fault = 0;
+        spindle_changed(sp, old);
+        if (!old)
+            mot->wait_at_speed = 1;
+        return MOT_ECHO_DONE;
+
+    case MOT_CMD_SPINDLE_OFF:
+        sp->speed = 0.0;
+        sp->css_factor = 0.0;
+        sp->on = 0;
+        sp->brake = 1;
+        sp->orient_state = MOT_ORIENT_NONE;
+        if (!any_spindle_on())
+            mot->wait_at_speed = 0;     /* nothing left to wait for */
+        return MOT_ECHO_DONE;
+
+    case MOT_CMD_SPINDLE_INCREASE:
+    case MOT_CMD_SPINDLE_DECREASE:
+        if ((r = bad_nonneg("speed step", c->value)))
+            return r;
+        if (!sp->on || sp->speed == 0)
+            return reject("%s: spindle %d is off", name, n);
+        step = c->value > 0 ? c->value : 0.1 * fabs(sp->speed);
+        if (c->cmd == MOT_CMD_SPINDLE_DECREASE) {
+            if (step >= fabs(sp->speed))
+                return reject("SPINDLE_DECREASE: a step of %g rpm would "
+                              "stop spindle %d (now %g rpm); use "
+                              "SPINDLE_OFF", step, n, sp->speed);
+            step = -step;
+        }
+        sp->speed += sp->speed > 0 ? step : -step;
+        spindle_changed(sp, old);
+        return MOT_ECHO_DONE;
+
+    case MOT_CMD_SPINDLE_ORIENT:
+        if (!mot->enabled)
+            return reject("SPINDLE_ORIENT needs motion enabled");
+        if ((r = bad_pos("orient angle", c->value)))
+            return r;
+        sp->speed = 0.0;
+        sp->css_factor = 0.0;
+        sp->on = 0;
+        sp->brake = 0;
+        sp->orient_angle = c->value;
+        sp->orient_mode = c->ival;
+        sp->orient_fault = 0;
+        sp->orient_state = MOT_ORIENT_RUNNING;
+        return MOT_ECHO_ACCEPTED;
+
+    case MOT_CMD_SPINDLE_BRAKE_ENGAGE:
+        if (sp->on && sp->speed != 0)
+            return reject("SPINDLE_BRAKE_ENGAGE: spindle %d turns (%g rpm); "
+                          "send SPINDLE_OFF first", n, sp->speed);
+        sp->brake = 1;
+        return MOT_ECHO_DONE;
+
+    case MOT_CMD_SPINDLE_BRAKE_RELEASE:
+        sp->brake = 0;
+        return MOT_ECHO_DONE;
+    }
+    return reject("%s is not a spindle command", name);
+}
+
+void mot_spindles_stop(void)
+{
+    int i;
+    mot->wait_at_speed = 0;
+    for (i = 0; i < mot->num_spindles; i++) {
+        mot_spindle_t *sp = &mot->spindle[i];
+        if (sp->on) {
+            sp->brake = 1;
+        }
+        sp->speed = 0.0;
+        sp->css_factor = 0.0;
+        sp->on = 0;
+        if (sp->orient_state == MOT_ORIENT_RUNNING)
+            sp->orient_state = MOT_ORIENT_NONE;
+        if (sp->index_armed) {
+            *mot->sp[i].index_enable = 0;
+            sp->index_armed = 0;
+        }
+    }
+}
+
 /* ---- the dispatcher ---- */
 static int run_command(const mot_command_t *c)
 {
@@ -603,6 +800,7 @@ static int run_command(const mot_command_t *c)
             for (i = 0; i < mot->num_joints; i++)
                 mot->joints[i].free_tp.enable = 0;
         }
+        mot_queue_drop();
         return MOT_ECHO_DONE;
 
     case MOT_CMD_FREE:
@@ -616,7 +814,11 @@ static int run_command(const mot_command_t *c)
         w[0] = 0;
         if (!*mot->mp->enable)
             return reject("ENABLE: motion.enable is false");
-        mot->tp->abort();
+        if (mot->tp->reset)
+            mot->tp->reset();
+        else
+            mot->tp->abort();
+        mot_line_clear();
         for (i = 0; i < mot->num_joints; i++) {
             mot->amp_on[i] = 0;
             mot->joints[i].ferror_high_mark = 0;
@@ -922,8 +1124,11 @@ static int run_command(const mot_command_t *c)
                           "condition (0 stop, 1 exact, 2 blend)", c->ival);
         if ((r = bad_nonneg("tolerance", c->tolerance)))
             return r;
+        if ((r = bad_nonneg("naive CAM tolerance (value)", c->value)))
+            return r;
         mot->term_cond = c->ival;
         mot->tolerance = c->tolerance;
+        mot->cam_tolerance = c->value;
         return MOT_ECHO_DONE;
 
     case MOT_CMD_SET_OFFSET:
@@ -950,6 +1155,15 @@ static int run_command(const mot_command_t *c)
         if (c->index < 0 || c->index >= mot->num_dio)
             return reject("digital output %d does not exist (num_dio=%d)",
                           c->index, mot->num_dio);
+        if (c->sync != 0 && c->sync != 1)
+            return reject("SET_DOUT: sync must be 0 (now) or 1 (at the "
+                          "start of the next move), got %d", c->sync);
+        if (c->sync) {
+            if (mot->tp->set_dout(c->index, c->ival ? 1 : 0, 0) < 0)
+                return reject("SET_DOUT: the trajectory planner has no "
+                              "room for another synchronized output");
+            return MOT_ECHO_ACCEPTED;
+        }
         *mot->mp->digital_out[c->index] = c->ival ? 1 : 0;
         return MOT_ECHO_DONE;
 
@@ -959,8 +1173,47 @@ static int run_command(const mot_command_t *c)
                           c->index, mot->num_aio);
         if ((r = bad_pos("analog value", c->value)))
             return r;
+        if (c->sync != 0 && c->sync != 1)
+            return reject("SET_AOUT: sync must be 0 (now) or 1 (at the "
+                          "start of the next move), got %d", c->sync);
+        if (c->sync) {
+            if (mot->tp->set_aout(c->index, c->value, 0) < 0)
+                return reject("SET_AOUT: the trajectory planner has no "
+                              "room for another synchronized output");
+            return MOT_ECHO_ACCEPTED;
+        }
         *mot->mp->analog_out[c->index] = c->value;
         return MOT_ECHO_DONE;
+
+    case MOT_CMD_SET_FEED_HOLD_ENABLE:
+    case MOT_CMD_SET_ADAPTIVE_FEED_ENABLE:
+        if (c->ival != 0 && c->ival != 1)
+            return reject("%s takes 1 (enable) or 0 (disable), got %d",
+                          cmd_name(c->cmd), c->ival);
+        if (c->cmd == MOT_CMD_SET_FEED_HOLD_ENABLE)
+            mot->feed_hold_enabled = c->ival;
+        else
+            mot->adaptive_enabled = c->ival;
+        return MOT_ECHO_DONE;
+
+    case MOT_CMD_SET_LINEAR_UNITS:
+        if ((r = bad_nonneg("millimetres per length unit", c->value)))
+            return r;
+        mot->linear_units = c->value;
+        return MOT_ECHO_DONE;
+
+    case MOT_CMD_SPINDLE_ON:
+    case MOT_CMD_SPINDLE_OFF:
+    case MOT_CMD_SPINDLE_INCREASE:
+    case MOT_CMD_SPINDLE_DECREASE:
+    case MOT_CMD_SPINDLE_ORIENT:
+    case MOT_CMD_SPINDLE_BRAKE_ENGAGE:
+    case MOT_CMD_SPINDLE_BRAKE_RELEASE:
+        return cmd_spindle(c);
+
+    case MOT_CMD_SPINDLE_SYNC_LINE:
+    case MOT_CMD_RIGID_TAP:
+        return cmd_move(c);
 
     default:
         if (c->cmd >= MOT_CMD_RESERVED_FIRST
@@ -969,6 +1222,141 @@ static int run_command(const mot_command_t *c)
                           c->cmd);
         return reject("unknown command code %d", c->cmd);
     }
+}
+
+/* ---- the move queue (channel.h "The move queue") ---- */
+static int queueable(int cmd)
+{
+    switch (cmd) {
+    case MOT_CMD_SET_LINE:
+    case MOT_CMD_SET_CIRCLE:
+    case MOT_CMD_PROBE:
+    case MOT_CMD_SPINDLE_SYNC_LINE:
+    case MOT_CMD_RIGID_TAP:
+    case MOT_CMD_SET_DOUT:
+    case MOT_CMD_SET_AOUT:
+    case MOT_CMD_SET_TERM_COND:
+    case MOT_CMD_SET_VEL:
+    case MOT_CMD_SET_ACC:
+    case MOT_CMD_SET_VEL_LIMIT:
+    case MOT_CMD_SET_FEED_HOLD_ENABLE:
+    case MOT_CMD_SET_ADAPTIVE_FEED_ENABLE:
+    case MOT_CMD_SPINDLE_ON:
+    case MOT_CMD_SPINDLE_OFF:
+    case MOT_CMD_SPINDLE_INCREASE:
+    case MOT_CMD_SPINDLE_DECREASE:
+    case MOT_CMD_SPINDLE_BRAKE_ENGAGE:
+    case MOT_CMD_SPINDLE_BRAKE_RELEASE:
+        return 1;
+    }
+    return 0;
+}
+
+/* records that take a place in the planner's queue */
+static int is_move(int cmd)
+{
+    return cmd == MOT_CMD_SET_LINE || cmd == MOT_CMD_SET_CIRCLE
+           || cmd == MOT_CMD_PROBE || cmd == MOT_CMD_SPINDLE_SYNC_LINE
+           || cmd == MOT_CMD_RIGID_TAP || cmd == MOT_CMD_SET_DOUT
+           || cmd == MOT_CMD_SET_AOUT;
+}
+
+/* moves that wait for the spindle's at-speed after a speed change */
+static int waits_for_spindle(const mot_command_t *c)
+{
+    if (c->cmd == MOT_CMD_SPINDLE_SYNC_LINE || c->cmd == MOT_CMD_RIGID_TAP)
+        return 1;
+    return (c->cmd == MOT_CMD_SET_LINE || c->cmd == MOT_CMD_SET_CIRCLE)
+           && (c->motion_type == MOT_MOTION_FEED
+               || c->motion_type == MOT_MOTION_ARC);
+}
+
+static int spindles_at_speed(void)
+{
+    int i;
+    for (i = 0; i < mot->num_spindles; i++)
+        if (mot->spindle[i].on && mot->spindle[i].speed != 0
+            && !*mot->sp[i].at_speed)
+            return 0;
+    return 1;
+}
+
+void mot_queue_drop(void)
+{
+    mot_channel_t *ch = mot->chan;
+    if (!ch)
+        return;
+    __atomic_store_n(&ch->q_tail, __atomic_load_n(&ch->q_head,
+                                                  __ATOMIC_ACQUIRE),
+                     __ATOMIC_RELEASE);
+}
+
+static void queue_failed(mot_channel_t *ch, const mot_command_t *c,
+                         const char *reason)
+{
+    ch->q_err_cmd = c->cmd;
+    ch->q_err_id = c->id;
+    ch->q_err_line = c->line;
+    snprintf(ch->q_err_reason, sizeof(ch->q_err_reason), "%s", reason);
+    mot_post("queued %s (id %d, line %d) rejected: %s; the rest of the "
+             "queue is dropped", cmd_name(c->cmd), c->id, c->line, reason);
+    __atomic_store_n(&ch->q_err_count, ch->q_err_count + 1,
+                     __ATOMIC_RELEASE);
+}
+
+static void drain_queue(mot_channel_t *ch)
+{
+    uint32_t head = __atomic_load_n(&ch->q_head, __ATOMIC_ACQUIRE);
+    uint32_t tail = ch->q_tail;
+    char w[MOT_REASON_LEN];
+    mot_command_t c;
+    int n = 0, st;
+
+    if (head == tail)
+        return;
+    if (head - tail > MOT_QUEUE_SIZE) {
+        mot_post("the move queue holds %u records, more than its %d "
+                 "places (a client broke the protocol): dropped",
+                 head - tail, MOT_QUEUE_SIZE);
+        memset(&c, 0, sizeof(c));
+        queue_failed(ch, &c, "the move queue overflowed");
+        __atomic_store_n(&ch->q_tail, head, __ATOMIC_RELEASE);
+        return;
+    }
+    while (tail != head && n < MOT_QUEUE_BURST) {
+        const mot_command_t *q = &ch->queue[tail % MOT_QUEUE_SIZE];
+        if (q->epoch != ch->q_err_count) {
+            tail++;                     /* after a rejection: dropped */
+            continue;
+        }
+        if (is_move(q->cmd) && mot->tp->queue_space() <= 0)
+            break;                      /* the planner is full */
+        if (mot->wait_at_speed && waits_for_spindle(q)) {
+            /* the first feed move after a spindle start or speed change
+               starts at rest with the spindles at speed: hold the queue
+               until the planner has run out and at-speed is true */
+            if (!mot->tp_done || !spindles_at_speed())
+                break;
+            mot->wait_at_speed = 0;
+        }
+        memcpy(&c, q, sizeof(c));
+        why = w;
+        whylen = sizeof(w);
+        w[0] = 0;
+        if (queueable(c.cmd))
+            st = run_command(&c);
+        else
+            st = reject("%s cannot be queued (only moves and what must "
+                        "keep its order with them)", cmd_name(c.cmd));
+        tail++;
+        n++;
+        if (st == MOT_ECHO_REJECTED) {
+            queue_failed(ch, &c, w[0] ? w : "no reason given");
+            /* the records after it have the old epoch: dropped in the
+               next cycles (or right now) */
+        }
+    }
+    __atomic_store_n(&ch->q_tail, tail, __ATOMIC_RELEASE);
 }
 
 void mot_command_handler(void *arg, long period)
@@ -983,9 +1371,21 @@ void mot_command_handler(void *arg, long period)
     if (!ch)
         return;
     seq = __atomic_load_n(&ch->cmd_seq, __ATOMIC_ACQUIRE);
-    if (seq == mot->last_seq)
+    if (seq == mot->last_seq) {
+        drain_queue(ch);
         return;
+    }
     memcpy(&c, (const void *)&ch->command, sizeof(c));
+    if (mot->wait_at_speed && waits_for_spindle(&c) && mot->enabled
+        && mot->mode == MOT_MODE_COORD) {
+        /* a feed move after a spindle start: taken (and echoed) once the
+           planner has run out and the spindles are at speed */
+        if (!mot->tp_done || !spindles_at_speed()) {
+            drain_queue(ch);
+            return;
+        }
+        mot->wait_at_speed = 0;
+    }
     mot->last_seq = seq;
 
     why = ch->echo_reason;
@@ -997,4 +1397,5 @@ void mot_command_handler(void *arg, long period)
     ch->echo_status = st;
     ch->echo_cmd = c.cmd;
     __atomic_store_n(&ch->echo_seq, seq, __ATOMIC_RELEASE);
+    drain_queue(ch);
 }

@@ -15,7 +15,16 @@
  *      positions to the servo rate (coord);
  *   5. adds backlash/screw compensation and the motor offset:
  *      motor_pos_cmd = pos_cmd + backlash_filt + motor_offset;
- *   6. writes the output pins and the status snapshot (seqlock).
+ *   6. runs the spindles (amplifier faults, the orient handshake, speed
+ *      and direction outputs, CSS);
+ *   7. writes the output pins and the status snapshot (seqlock).
+ *
+ * Feed hold (when enabled, M53), feed inhibit and adaptive feed (when
+ * enabled, M52) are read once per cycle and handed to the planner with
+ * its inputs (tp.h v2), with the per-spindle revs, speed, at-speed and
+ * index-enable.  motion.program-line and motion.requested-vel come from
+ * a list of the moves given to the planner (id, line, vel), followed by
+ * the planner's exec_id.
  *
  * The seven positions of the developer manual: carte_pos_cmd (mot->
  * carte_pos_cmd), coarse_pos (joint coarse_pos: the planner's output
@@ -240,8 +249,15 @@ void mot_disable(void)
     for (i = 0; i < mot->num_joints; i++)
         mot->homing_c[i] = 0;
     mot->any_homing_c = 0;
-    if (mot->tp)
-        mot->tp->abort();
+    if (mot->tp) {
+        if (mot->tp->reset)
+            mot->tp->reset();
+        else
+            mot->tp->abort();
+    }
+    mot_line_clear();
+    mot_queue_drop();
+    mot_spindles_stop();
     mot->enabled = 0;
     for (i = 0; i < mot->num_joints; i++)
         mot->amp_on[i] = 0;
@@ -591,6 +607,48 @@ static void run_teleop(double dt)
         mot->joints[i].coarse_pos = mot->joints[i].pos_cmd;
 }
 
+void mot_line_clear(void)
+{
+    mot->line_head = mot->line_count = 0;
+    mot->program_line = 0;
+    mot->move_req_vel = 0.0;
+}
+
+void mot_line_push(int id, int line, double vel)
+{
+    if (mot->line_count == MOT_LINE_FIFO) {     /* forget the oldest */
+        mot->line_head = (mot->line_head + 1) % MOT_LINE_FIFO;
+        mot->line_count--;
+    }
+    mot->lines[(mot->line_head + mot->line_count) % MOT_LINE_FIFO] =
+        (struct mot_line){ id, line, vel };
+    mot->line_count++;
+}
+
+/* follow the planner's exec_id through the remembered moves: the line
+   and requested velocity of the move that runs (merged or skipped moves
+   are passed over, up to 256 at a time) */
+static void line_track(const tp_state_t *st)
+{
+    int k;
+
+    if (st->done && st->queue_depth == 0) {
+        mot_line_clear();
+        return;
+    }
+    for (k = 0; k < mot->line_count && k < 256; k++) {
+        struct mot_line *e =
+            &mot->lines[(mot->line_head + k) % MOT_LINE_FIFO];
+        if (e->id == st->exec_id) {
+            mot->line_head = (mot->line_head + k) % MOT_LINE_FIFO;
+            mot->line_count -= k;
+            mot->program_line = e->line;
+            mot->move_req_vel = e->vel;
+            return;
+        }
+    }
+}
+
 static void run_coord(double dt)
 {
     int i, nk = used_kins_joints();
@@ -599,17 +657,11 @@ static void run_coord(double dt)
     const halsdk_tp_api_t *tp = mot->tp;
     const char *e;
 
-    /* overrides: feed scale x adaptive feed; feed hold and feed inhibit
-       stop the planner along its path (scale 0) */
+    /* overrides: feed scale x adaptive feed (when enabled); feed hold
+       (when enabled) and feed inhibit stop the planner along its path
+       (scale 0) */
     {
-        double af = *mot->mp->adaptive_feed, f, r;
-        int hold = *mot->mp->feed_hold || *mot->mp->feed_inhibit;
-        if (!(af >= 0))
-            af = 0;
-        if (af > 1)
-            af = 1;
-        f = hold ? 0.0 : mot->feed_scale * af;
-        r = hold ? 0.0 : mot->rapid_scale;
+        double f = mot->feed_scale, r = mot->rapid_scale;
         if (f != mot->tp_feed || r != mot->tp_rapid) {
             mot->tp_feed = f;
             mot->tp_rapid = r;
@@ -627,6 +679,16 @@ static void run_coord(double dt)
         in.spindle_revs = *mot->sp[0].revs;
         in.spindle_speed = *mot->sp[0].speed_in;
         in.spindle_at_speed = *mot->sp[0].at_speed ? 1 : 0;
+        in.have = TP_IN_FEED | TP_IN_SPINDLES;
+        in.feed_hold = mot->feed_hold_now;
+        in.feed_inhibit = mot->feed_inhibit_now;
+        in.adaptive_feed = mot->adaptive_now;
+        for (i = 0; i < mot->num_spindles && i < TP_MAX_SPINDLES; i++) {
+            in.spindle[i].revs = *mot->sp[i].revs;
+            in.spindle[i].speed = *mot->sp[i].speed_in;
+            in.spindle[i].at_speed = *mot->sp[i].at_speed ? 1 : 0;
+            in.spindle[i].index_enable = *mot->sp[i].index_enable ? 1 : 0;
+        }
         mot->coarse_prev = mot->coarse_next;
         tp->run_cycle(&in, &mot->coarse_next);
         memset(&st, 0, sizeof(st));
@@ -640,7 +702,10 @@ static void run_coord(double dt)
         mot->current_vel = st.vel;
         mot->distance_to_go = st.dtg;
         mot->par->vel_out = st.vel;
-        mot->par->active_tc = st.queue_depth > 0 ? 1 : 0;
+        mot->par->active_tc = st.active_moves > 0 ? st.active_moves
+                              : (st.queue_depth > 0 ? 1 : 0);
+        mot->tp_spindle_wait = st.waiting;
+        line_track(&st);
         r = tp->probe_result(&pr);
         if (r == 1 && !mot->probe_tripped) {
             mot->probe_tripped = 1;
@@ -705,6 +770,94 @@ static void run_coord(double dt)
 
 static void write_pins(double dt, long period);
 
+/* feed hold (when enabled: M53), feed inhibit and adaptive feed (when
+   enabled: M52) for this cycle */
+static void read_feed_inputs(void)
+{
+    double af = *mot->mp->adaptive_feed;
+
+    mot->feed_hold_now = mot->feed_hold_enabled && *mot->mp->feed_hold;
+    mot->feed_inhibit_now = *mot->mp->feed_inhibit ? 1 : 0;
+    if (!mot->adaptive_enabled)
+        af = 1.0;
+    else if (!(af >= 0.0))          /* negative or NaN: stop */
+        af = 0.0;
+    else if (af > 1.0)
+        af = 1.0;
+    mot->adaptive_now = af;
+}
+
+/* the spindle's commanded speed in rpm (signed), CSS included */
+static double spindle_rpm(int n)
+{
+    mot_spindle_t *sp = &mot->spindle[n];
+    double rpm = sp->speed, r;
+
+    if (!sp->on)
+        return 0.0;
+    if (sp->css_factor > 0 && rpm != 0) {
+        r = fabs(*emcpose_axis(&mot->carte_pos_cmd, sp->css_axis));
+        rpm = sp->css_max > 0 ? sp->css_max : fabs(sp->speed);
+        if (r > 1e-9 && sp->css_factor / (2.0 * M_PI * r) < rpm)
+            rpm = sp->css_factor / (2.0 * M_PI * r);
+        if (sp->speed < 0)
+            rpm = -rpm;
+    }
+    return rpm;
+}
+
+/* spindles: amplifier faults, the orient handshake, the output pins */
+static void run_spindles(void)
+{
+    int n;
+
+    for (n = 0; n < mot->num_spindles; n++) {
+        mot_spindle_t *sp = &mot->spindle[n];
+        mot_spindle_pins_t *p = &mot->sp[n];
+        double rpm;
+
+        /* like a joint's amplifier fault: motion cannot stay enabled
+           while it is true */
+        sp->amp_fault = *p->amp_fault_in ? 1 : 0;
+        if (sp->amp_fault && mot->enabled) {
+            mot_post("spindle %d amplifier fault (spindle.%d.amp-fault-in): "
+                     "motion disabled", n, n);
+            fault();
+        }
+        if (sp->orient_state == MOT_ORIENT_RUNNING) {
+            if (*p->orient_fault != 0) {
+                sp->orient_fault = *p->orient_fault;
+                sp->orient_state = MOT_ORIENT_FAULT;
+                mot_post("spindle %d orient failed: spindle.%d.orient-fault "
+                         "is %d", n, n, sp->orient_fault);
+            } else if (*p->is_oriented) {
+                sp->orient_state = MOT_ORIENT_DONE;
+                sp->brake = 1;
+            }
+        }
+        rpm = spindle_rpm(n);
+        if (sp->reversed)
+            rpm = -rpm;                 /* rigid tap: coming back out */
+        *p->speed_cmd_rps = rpm / 60.0;
+        if (*p->inhibit)
+            rpm = 0.0;
+        *p->on = sp->on && sp->speed != 0;
+        *p->forward = *p->on && (sp->speed > 0) != (sp->reversed != 0);
+        *p->reverse = *p->on && !*p->forward;
+        *p->brake = sp->brake;
+        *p->speed_out = rpm;
+        *p->speed_out_abs = fabs(rpm);
+        *p->speed_out_rps = rpm / 60.0;
+        *p->speed_out_rps_abs = fabs(rpm) / 60.0;
+        *p->orient = sp->orient_state == MOT_ORIENT_RUNNING;
+        *p->locked = sp->orient_state == MOT_ORIENT_DONE;
+        *p->orient_angle = sp->orient_angle;
+        *p->orient_mode = sp->orient_mode;
+        if (sp->index_armed && !*p->index_enable)
+            sp->index_armed = 0;        /* the encoder saw the index */
+    }
+}
+
 void mot_controller(void *arg, long period)
 {
     int i, homing;
@@ -726,6 +879,7 @@ void mot_controller(void *arg, long period)
         mot_post("%s", e);
     refresh_home_cache();
     check_faults();
+    read_feed_inputs();
 
     if (!mot->enabled) {
         /* commands follow the feedback */
@@ -758,10 +912,11 @@ void mot_controller(void *arg, long period)
                and the next move start from here */
             tp_inputs_t in;
             EmcPose dummy;
-            memset(&in, 0, sizeof(in));
             int k;
-            /* (tp.h has no "drop everything now": run the aborted
-               planner fast, at most 50 of its cycles per servo cycle) */
+            memset(&in, 0, sizeof(in));
+            if (mot->tp->reset && !mot->tp->is_done())
+                mot->tp->reset();
+            /* (a planner without reset: run it fast until it is done) */
             for (k = 0; k < 50 && !mot->tp->is_done(); k++)
                 mot->tp->run_cycle(&in, &dummy);
             if (mot->tp->is_done())
@@ -850,6 +1005,7 @@ void mot_controller(void *arg, long period)
         mot->carte_fb_ok = 0;
     }
 
+    run_spindles();
     write_pins(dt, period);
     mot->home->write_outputs();
     mot_write_status();
@@ -963,16 +1119,31 @@ static void write_pins(double dt, long period)
     *mp->distance_to_go = mot->distance_to_go;
     *mp->motion_type = mot->mode == MOT_MODE_COORD && !mot->tp_done
                        ? mot->motion_type : 0;
-    *mp->requested_vel = mot->req_vel;
-    /* feed rate of feed moves and arcs: the requested velocity (SET_VEL)
-       times the overrides, 0 while held; per minute.  The inch and mm
-       pins stay 0: motmod is not told the machine's length units */
-    if (mot->mode == MOT_MODE_COORD && !mot->tp_done
-        && (mot->motion_type == MOT_MOTION_FEED
-            || mot->motion_type == MOT_MOTION_ARC))
-        *mp->feed_upm = mot->req_vel * mot->tp_feed * 60.0;
-    else
-        *mp->feed_upm = 0.0;
+    {
+        int running = mot->mode == MOT_MODE_COORD && mot->enabled
+                      && !mot->tp_done;
+        double upm = 0.0, mm;
+        /* the requested velocity of the move that runs (without
+           overrides); idle: 0 */
+        *mp->requested_vel = running ? mot->move_req_vel : 0.0;
+        *mp->program_line = running || mot->tp_paused ? mot->program_line
+                                                       : 0;
+        /* feed rate of feed moves and arcs: the requested velocity times
+           the feed override and adaptive feed, 0 while held; per minute.
+           The mm and inch pins need SET_LINEAR_UNITS (else 0) */
+        if (running && (mot->motion_type == MOT_MOTION_FEED
+                        || mot->motion_type == MOT_MOTION_ARC))
+            upm = mot->feed_hold_now || mot->feed_inhibit_now ? 0.0
+                  : mot->move_req_vel * mot->feed_scale * mot->adaptive_now
+                    * 60.0;
+        mot->feed_upm = upm;
+        *mp->feed_upm = upm;
+        mm = upm * mot->linear_units;
+        *mp->feed_mm_per_minute = mm;
+        *mp->feed_mm_per_second = mm / 60.0;
+        *mp->feed_inches_per_minute = mm / 25.4;
+        *mp->feed_inches_per_second = mm / 25.4 / 60.0;
+    }
     *mp->servo_last_period = (hal_u32_t)period;
     *mp->coord_error = 0;
     mot->par->pos_out = mot->mode == MOT_MODE_COORD
@@ -1040,6 +1211,41 @@ void mot_write_status(void)
             s->dout |= 1ull << i;
         if (*mot->mp->digital_in[i])
             s->din |= 1ull << i;
+    }
+    s->program_line = *mot->mp->program_line;
+    s->feed_hold_enabled = mot->feed_hold_enabled;
+    s->adaptive_enabled = mot->adaptive_enabled;
+    s->feed_hold = mot->feed_hold_now;
+    s->feed_inhibit = mot->feed_inhibit_now;
+    s->queue_taken = (int32_t)ch->q_tail;
+    s->queue_err_count = __atomic_load_n(&ch->q_err_count, __ATOMIC_RELAXED);
+    s->adaptive_feed = *mot->mp->adaptive_feed;
+    s->feed_upm = mot->feed_upm;
+    s->linear_units = mot->linear_units;
+    s->spindle_wait = mot->tp_spindle_wait;
+    s->queue_held = mot->wait_at_speed;
+    for (i = 0; i < mot->num_aio; i++) {
+        s->ain[i] = *mot->mp->analog_in[i];
+        s->aout[i] = *mot->mp->analog_out[i];
+    }
+    for (i = 0; i < mot->num_spindles; i++) {
+        mot_spindle_t *sp = &mot->spindle[i];
+        mot_spindle_pins_t *p = &mot->sp[i];
+        mot_spindle_status_t *ss = &s->spindle[i];
+        ss->speed = *p->speed_out;
+        ss->speed_in = *p->speed_in;
+        ss->revs = *p->revs;
+        ss->orient_angle = sp->orient_angle;
+        ss->css_factor = sp->css_factor;
+        ss->on = *p->on;
+        ss->direction = *p->forward ? 1 : (*p->reverse ? -1 : 0);
+        ss->brake = *p->brake;
+        ss->locked = *p->locked;
+        ss->orient_state = sp->orient_state;
+        ss->orient_fault = sp->orient_fault;
+        ss->at_speed = *p->at_speed;
+        ss->inhibit = *p->inhibit;
+        ss->amp_fault = *p->amp_fault_in;
     }
     for (i = 0; i < mot->num_joints; i++) {
         mot_joint_t *j = &mot->joints[i];

@@ -187,6 +187,23 @@ enum mot_jog_kind {
     MOT_JOG_WHEEL
 };
 
+/* one spindle's state (pins are in mot_spindle_pins_t) */
+typedef struct {
+    double speed;               /* commanded rpm, signed; 0: off */
+    double css_factor;          /* CSS surface speed (units/min), 0: off */
+    int css_axis;               /* axis the radius is measured on */
+    double css_max;             /* CSS rpm limit (0: none) */
+    int on;
+    int brake;                  /* braked by BRAKE_ENGAGE or orient */
+    int orient_state;           /* enum mot_orient_state */
+    double orient_angle;
+    int orient_mode;
+    int orient_fault;
+    int amp_fault;              /* latched until the next SPINDLE_ON */
+    int index_armed;            /* motmod armed index-enable for G33 */
+    int reversed;               /* rigid tap: turning the other way */
+} mot_spindle_t;
+
 /* one axis (X..W) in teleop mode */
 typedef struct {
     freeplan_t tp;              /* teleop planner */
@@ -254,6 +271,26 @@ typedef struct {
     int inpos;
     uint64_t dout_bits;
 
+    /* issue 7: feed control, the move queue, spindles */
+    int feed_hold_enabled;      /* SET_FEED_HOLD_ENABLE (default 1) */
+    int adaptive_enabled;       /* SET_ADAPTIVE_FEED_ENABLE (default 0) */
+    int feed_hold_now, feed_inhibit_now;    /* in force this cycle */
+    double adaptive_now;        /* factor applied this cycle */
+    double linear_units;        /* mm per length unit; 0: unknown */
+    double move_req_vel;        /* requested vel of the running move */
+    double feed_upm;            /* motion.feed-upm */
+    double cam_tolerance;       /* SET_TERM_COND value (G64 Q) */
+    /* the moves given to the planner, oldest first: their id, program
+       line and requested velocity, for motion.program-line and
+       motion.requested-vel while they run */
+    struct mot_line { int id, line; double vel; } *lines;
+    int line_head, line_count;
+    int program_line;
+    int tp_spindle_wait;        /* the planner waits for the spindle */
+    int wait_at_speed;          /* a spindle started or changed speed:
+                                   the next feed move waits */
+    mot_spindle_t spindle[MOT_MAX_SPINDLES];
+
     mot_joint_t *joints;        /* num_joints */
     mot_comp_t *comp;           /* num_joints: backlash and screw comp */
     int home_seq[MOT_MAX_JOINTS];       /* HOME_SEQUENCE of each joint */
@@ -281,9 +318,17 @@ extern mot_t *mot;
 
 /* mot_command.c */
 void mot_command_handler(void *arg, long period);
+/* drop the queued records not taken yet (ABORT, DISABLE, faults) */
+void mot_queue_drop(void);
+/* spindles off and released (DISABLE, faults) */
+void mot_spindles_stop(void);
+
+#define MOT_LINE_FIFO 8192     /* moves remembered (>= the planner queue) */
 
 /* mot_control.c */
 void mot_controller(void *arg, long period);
+void mot_line_push(int id, int line, double vel);
+void mot_line_clear(void);
 /* write the status snapshot of the channel (seqlock) */
 void mot_write_status(void);
 /* post an error message into the channel ring (and print it) */

@@ -270,7 +270,29 @@ static void hook_aout(int i, double v)
         *mot->mp->analog_out[i] = v;
 }
 
-static const tp_hooks_t tp_hooks = { hook_dout, hook_aout };
+/* G33: arm spindle.N.index-enable; the encoder resets it at the index */
+static void hook_index_enable(int n)
+{
+    if (n >= 0 && n < mot->num_spindles) {
+        *mot->sp[n].index_enable = 1;
+        mot->spindle[n].index_armed = 1;
+    }
+}
+
+/* rigid tapping: turn spindle n the other way than commanded (1) or back
+   (0) */
+static void hook_spindle_reverse(int n, int reverse)
+{
+    if (n >= 0 && n < mot->num_spindles)
+        mot->spindle[n].reversed = reverse ? 1 : 0;
+}
+
+static const tp_hooks_t tp_hooks = {
+    .set_dout = hook_dout,
+    .set_aout = hook_aout,
+    .index_enable = hook_index_enable,
+    .spindle_reverse = hook_spindle_reverse,
+};
 
 /* ---- modparam checks: before anything is created ---- */
 static int check_range(const char *name, int v, int lo, int hi)
@@ -410,6 +432,9 @@ static void init_state(void)
     mot->override_jog = -1;
     mot->tp_done = 1;
     mot->inpos = 1;
+    mot->feed_hold_enabled = 1;     /* the reference's default (M53 P1) */
+    mot->adaptive_enabled = 0;      /* off until M52 P1 */
+    mot->adaptive_now = 1.0;
     mot->enable_pin_old = 1;
     for (i = 0; i < mot->num_joints; i++) {
         mot_joint_t *j = &mot->joints[i];
@@ -485,8 +510,9 @@ int rtapi_app_main(void)
     mot->sp = hal_malloc(sizeof(mot_spindle_pins_t) * num_spindles);
     mot->mp = hal_malloc(sizeof(mot_motion_pins_t));
     mot->par = hal_malloc(sizeof(mot_params_t));
+    mot->lines = hal_malloc(sizeof(*mot->lines) * MOT_LINE_FIFO);
     if (!mot->joints || !mot->comp || !mot->jp || !mot->ap || !mot->sp
-        || !mot->mp || !mot->par)
+        || !mot->mp || !mot->par || !mot->lines)
         goto nomem;
     memset(mot->joints, 0, sizeof(mot_joint_t) * num_joints);
     memset(mot->jp, 0, sizeof(mot_joint_pins_t) * num_joints);

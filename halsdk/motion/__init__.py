@@ -15,9 +15,11 @@ See docs/motion.rst for the commands and the status.
 
 from halsdk.motion.client import (
     Cmd,
+    InputWait,
     Motion,
     MotionError,
     MotionTimeout,
+    QueueRejected,
     Rejected,
     homing_fields,
 )
@@ -28,13 +30,16 @@ from halsdk.motion.status import (
     KinsType,
     Mode,
     MotionType,
+    OrientState,
     Pose,
     Profile,
+    SpindleStatus,
     Status,
     TermCond,
 )
 
-__all__ = ["Motion", "Rejected", "MotionError", "MotionTimeout", "Cmd",
-           "Status", "JointStatus", "AxisStatus", "Mode", "KinsType",
+__all__ = ["Motion", "Rejected", "QueueRejected", "MotionError",
+           "MotionTimeout", "Cmd", "InputWait", "Status", "JointStatus",
+           "AxisStatus", "SpindleStatus", "OrientState", "Mode", "KinsType",
            "MotionType", "Profile", "TermCond", "Pose", "homing_fields",
            "MotionConfig", "MotionIniError", "read_motion_ini"]

@@ -72,6 +72,7 @@ cdef extern from "emcpose.h":
 cdef extern from "channel.h":
     int MOT_CHANNEL_MAGIC, MOT_CHANNEL_VERSION, MOT_MAX_JOINTS
     int MOT_MAX_AXES, MOT_REASON_LEN, MOT_MSG_LEN, MOT_MSG_RING
+    int MOT_QUEUE_SIZE, MOT_MAX_SPINDLES, MOT_MAX_AIO
 
     ctypedef struct mot_command_t:
         int32_t cmd, joint, axis, ival, index, id, motion_type, turn
@@ -84,6 +85,15 @@ cdef extern from "channel.h":
         double home_final_vel
         int32_t home_sequence, volatile_home
         uint32_t home_flags
+        int32_t line
+        uint32_t epoch
+        int32_t sync
+        double pitch
+
+    ctypedef struct mot_spindle_status_t:
+        double speed, speed_in, revs, orient_angle, css_factor
+        int32_t on, direction, brake, locked, orient_state, orient_fault
+        int32_t at_speed, inhibit, amp_fault
 
     ctypedef struct mot_joint_status_t:
         uint32_t flags
@@ -117,6 +127,14 @@ cdef extern from "channel.h":
         uint64_t dout, din
         mot_joint_status_t joint[16]
         mot_axis_status_t axis[9]
+        int32_t program_line, feed_hold_enabled, adaptive_enabled
+        int32_t feed_hold, feed_inhibit, queue_taken
+        uint32_t queue_err_count
+        double adaptive_feed, feed_upm, linear_units
+        double ain[64]
+        double aout[64]
+        mot_spindle_status_t spindle[8]
+        int32_t spindle_wait, queue_held
 
     ctypedef struct mot_msg_t:
         uint64_t n
@@ -133,6 +151,10 @@ cdef extern from "channel.h":
         mot_status_t status
         uint64_t msg_count
         mot_msg_t msgs[32]
+        uint32_t q_head, q_tail, q_err_count
+        int32_t q_err_cmd, q_err_id, q_err_line
+        char q_err_reason[200]
+        mot_command_t queue[1]
 
 
 class ChannelError(Exception):
@@ -173,17 +195,47 @@ cdef void _set_cart(PmCartesian *p, object v) except *:
 
 
 _INT_FIELDS = ("joint", "axis", "ival", "index", "id", "motion_type",
-               "turn", "home_sequence", "volatile_home")
+               "turn", "home_sequence", "volatile_home", "line", "sync")
 _FLOAT_FIELDS = ("vel", "ini_maxvel", "acc", "jerk", "offset", "value",
                  "min_limit", "max_limit", "tolerance", "home_offset",
                  "home", "home_search_vel", "home_latch_vel",
-                 "home_final_vel")
+                 "home_final_vel", "pitch")
 _KNOWN = set(_INT_FIELDS + _FLOAT_FIELDS +
              ("home_flags", "comp", "pos", "center", "normal"))
 
 SIZE = sizeof(mot_channel_t)
 MAX_JOINTS = MOT_MAX_JOINTS
 MSG_RING = MOT_MSG_RING
+QUEUE_SIZE = MOT_QUEUE_SIZE
+
+
+cdef void _fill(mot_command_t *rec, int cmd, dict args) except *:
+    unknown = set(args) - _KNOWN
+    if unknown:
+        raise TypeError(f"unknown command field(s) {sorted(unknown)}")
+    memset(rec, 0, sizeof(mot_command_t))
+    rec.cmd = cmd
+    rec.joint = -1
+    rec.axis = -1
+    for k in _INT_FIELDS:
+        if k in args:
+            setattr_int(rec, k, args[k])
+    for k in _FLOAT_FIELDS:
+        if k in args:
+            setattr_float(rec, k, args[k])
+    if "home_flags" in args:
+        rec.home_flags = args["home_flags"]
+    if "comp" in args:
+        v = args["comp"]
+        if len(v) != 3:
+            raise ValueError("comp needs 3 values")
+        rec.comp[0], rec.comp[1], rec.comp[2] = v[0], v[1], v[2]
+    if "pos" in args:
+        _set_pose(&rec.pos, args["pos"])
+    if "center" in args:
+        _set_cart(&rec.center, args["center"])
+    if "normal" in args:
+        _set_cart(&rec.normal, args["normal"])
 
 
 cdef class Channel:
@@ -273,32 +325,7 @@ cdef class Channel:
         cdef mot_channel_t *c = self.live()
         cdef mot_command_t rec
         cdef uint32_t seq
-        unknown = set(args) - _KNOWN
-        if unknown:
-            raise TypeError(f"unknown command field(s) {sorted(unknown)}")
-        memset(&rec, 0, sizeof(rec))
-        rec.cmd = cmd
-        rec.joint = -1
-        rec.axis = -1
-        for k in _INT_FIELDS:
-            if k in args:
-                setattr_int(&rec, k, args[k])
-        for k in _FLOAT_FIELDS:
-            if k in args:
-                setattr_float(&rec, k, args[k])
-        if "home_flags" in args:
-            rec.home_flags = args["home_flags"]
-        if "comp" in args:
-            v = args["comp"]
-            if len(v) != 3:
-                raise ValueError("comp needs 3 values")
-            rec.comp[0], rec.comp[1], rec.comp[2] = v[0], v[1], v[2]
-        if "pos" in args:
-            _set_pose(&rec.pos, args["pos"])
-        if "center" in args:
-            _set_cart(&rec.center, args["center"])
-        if "normal" in args:
-            _set_cart(&rec.normal, args["normal"])
+        _fill(&rec, cmd, args)
         memcpy(&c.command, &rec, sizeof(rec))
         seq = mch_load32(&c.cmd_seq) + 1
         if seq == 0:
@@ -317,6 +344,55 @@ cdef class Channel:
         memcpy(reason, c.echo_reason, 200)
         reason[199] = 0
         return seq, st, code, reason.decode("utf-8", "replace")
+
+    # ---------------------------------------------------------- queue
+
+    def queue_state(self) -> tuple:
+        """(q_head, q_tail, q_err_count) of the move queue ring."""
+        cdef mot_channel_t *c = self.live()
+        cdef uint32_t err = mch_load32(&c.q_err_count)
+        cdef uint32_t tail = mch_load32(&c.q_tail)
+        return mch_load32(&c.q_head), tail, err
+
+    def queue_free(self) -> int:
+        """Places free in the move queue ring."""
+        cdef mot_channel_t *c = self.live()
+        cdef uint32_t used = mch_load32(&c.q_head) - mch_load32(&c.q_tail)
+        return MOT_QUEUE_SIZE - <int>used
+
+    def push(self, int cmd, dict args, uint32_t epoch) -> int:
+        """Write one record into the move queue ring.  Returns 0 when it
+        was written, 1 when the ring is full, or the pid of the live
+        process that holds the client lock (nothing written)."""
+        cdef mot_channel_t *c = self.live()
+        cdef mot_command_t rec
+        cdef uint32_t head, tail
+        _fill(&rec, cmd, args)
+        rec.epoch = epoch
+        owner = self.try_lock()
+        if owner:
+            return owner
+        try:
+            head = c.q_head
+            tail = mch_load32(&c.q_tail)
+            if head - tail >= <uint32_t>MOT_QUEUE_SIZE:
+                return 1
+            memcpy(&c.queue[head % MOT_QUEUE_SIZE], &rec, sizeof(rec))
+            mch_store32(&c.q_head, head + 1)
+            return 0
+        finally:
+            self.unlock()
+
+    def queue_error(self) -> tuple:
+        """(q_err_count, cmd, id, line, reason) of the last rejected
+        queued record."""
+        cdef mot_channel_t *c = self.live()
+        cdef uint32_t n = mch_load32(&c.q_err_count)
+        cdef char reason[200]
+        memcpy(reason, c.q_err_reason, 200)
+        reason[199] = 0
+        return (n, c.q_err_cmd, c.q_err_id, c.q_err_line,
+                reason.decode("utf-8", "replace"))
 
     # ---------------------------------------------------------- status
 
@@ -406,6 +482,10 @@ cdef void setattr_int(mot_command_t *r, str k, object v) except *:
         r.home_sequence = x
     elif k == "volatile_home":
         r.volatile_home = x
+    elif k == "line":
+        r.line = x
+    elif k == "sync":
+        r.sync = x
 
 
 cdef void setattr_float(mot_command_t *r, str k, object v) except *:
@@ -438,6 +518,8 @@ cdef void setattr_float(mot_command_t *r, str k, object v) except *:
         r.home_latch_vel = x
     elif k == "home_final_vel":
         r.home_final_vel = x
+    elif k == "pitch":
+        r.pitch = x
 
 
 cdef dict _joint_dict(mot_joint_status_t *j):
@@ -463,6 +545,16 @@ cdef dict _axis_dict(mot_axis_status_t *a):
         vel_limit=a.vel_limit, acc_limit=a.acc_limit,
         jerk_limit=a.jerk_limit, teleop_active=a.teleop_active != 0,
         jog_active=a.jog_active != 0)
+
+
+cdef dict _spindle_dict(mot_spindle_status_t *p):
+    return dict(
+        speed=p.speed, speed_in=p.speed_in, revs=p.revs,
+        orient_angle=p.orient_angle, css_factor=p.css_factor,
+        on=p.on != 0, direction=p.direction, brake=p.brake != 0,
+        locked=p.locked != 0, orient_state=p.orient_state,
+        orient_fault=p.orient_fault, at_speed=p.at_speed != 0,
+        inhibit=p.inhibit != 0, amp_fault=p.amp_fault != 0)
 
 
 cdef dict _status_dict(mot_status_t *s):
@@ -495,5 +587,18 @@ cdef dict _status_dict(mot_status_t *s):
         carte_pos_fb_ok=s.carte_pos_fb_ok != 0,
         probed_pos=_pose(&s.probed_pos), tool_offset=_pose(&s.tool_offset),
         dout=s.dout, din=s.din,
+        program_line=s.program_line,
+        feed_hold_enabled=s.feed_hold_enabled != 0,
+        adaptive_enabled=s.adaptive_enabled != 0,
+        feed_hold=s.feed_hold != 0, feed_inhibit=s.feed_inhibit != 0,
+        queue_taken=<uint32_t>s.queue_taken,
+        queue_err_count=s.queue_err_count,
+        adaptive_feed=s.adaptive_feed, feed_upm=s.feed_upm,
+        linear_units=s.linear_units, spindle_wait=s.spindle_wait,
+        queue_held=s.queue_held != 0,
+        ain=[s.ain[i] for i in range(min(max(s.num_aio, 0), MOT_MAX_AIO))],
+        aout=[s.aout[i] for i in range(min(max(s.num_aio, 0), MOT_MAX_AIO))],
+        spindles=[_spindle_dict(&s.spindle[i]) for i in
+                  range(min(max(s.num_spindles, 0), MOT_MAX_SPINDLES))],
         joints=[_joint_dict(&s.joint[i]) for i in range(n)],
         axes=[_axis_dict(&s.axis[i]) for i in range(MOT_MAX_AXES)])

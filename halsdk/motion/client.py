@@ -37,7 +37,8 @@ from halsdk.motion.status import (
     TermCond,
 )
 
-__all__ = ["Motion", "Rejected", "MotionError", "MotionTimeout", "Cmd"]
+__all__ = ["Motion", "Rejected", "QueueRejected", "MotionError",
+           "MotionTimeout", "Cmd", "InputWait"]
 
 CHANNEL_NAME = "motmod.channel"
 
@@ -62,6 +63,40 @@ class Rejected(HalError):
         super().__init__(f"{command} rejected: {reason}")
         self.command = command
         self.reason = reason
+
+
+class QueueRejected(Rejected):
+    """motmod refused a queued record (sent with a ``queue_*`` method);
+    the queue stopped there and the records written after it were dropped.
+    Raised by the next call of the client after motmod saw it.
+
+    :ivar id: the motion id of the record.
+    :ivar line: its program line.
+    """
+
+    def __init__(self, command: str, reason: str, id: int, line: int):
+        Rejected.__init__(self, command, reason)
+        self.args = (f"queued {command} (id {id}, line {line}) rejected: "
+                     f"{reason}",)
+        self.id = id
+        self.line = line
+
+    def __str__(self) -> str:
+        return self.args[0]
+
+
+class InputWait(enum.IntEnum):
+    """Modes of :meth:`Motion.wait_input` (the L word of M66)."""
+    IMMEDIATE = 0   #: no wait: the value now
+    RISE = 1        #: a digital input going from false to true
+    FALL = 2        #: a digital input going from true to false
+    HIGH = 3        #: a digital input being true
+    LOW = 4         #: a digital input being false
+
+
+# length units of SET_LINEAR_UNITS: millimetres per unit
+LINEAR_UNITS = {"mm": 1.0, "metric": 1.0, "cm": 10.0, "inch": 25.4,
+                "in": 25.4, "imperial": 25.4}
 
 
 class Cmd(enum.IntEnum):
@@ -117,6 +152,18 @@ class Cmd(enum.IntEnum):
     SET_PROFILE = 71
     SET_DOUT = 72
     SET_AOUT = 73
+    SET_FEED_HOLD_ENABLE = 100
+    SET_ADAPTIVE_FEED_ENABLE = 101
+    SET_LINEAR_UNITS = 102
+    SPINDLE_ON = 110
+    SPINDLE_OFF = 111
+    SPINDLE_INCREASE = 112
+    SPINDLE_DECREASE = 113
+    SPINDLE_ORIENT = 114
+    SPINDLE_BRAKE_ENGAGE = 115
+    SPINDLE_BRAKE_RELEASE = 116
+    SPINDLE_SYNC_LINE = 120
+    RIGID_TAP = 121
 
 
 class Echo(enum.IntEnum):
@@ -180,6 +227,8 @@ class Motion:
         self._pending: list[str] = []
         self._next_id = 1
         self._last_end: Optional[Pose] = None
+        # the queue rejections seen so far (records carry it as epoch)
+        self._q_epoch = channel.queue_state()[2]
 
     # ------------------------------------------------------------ connect
 
@@ -285,6 +334,7 @@ class Motion:
         :class:`Rejected` with motmod's reason."""
         cmd = Cmd(cmd)
         ch = self._ch
+        self._check_queue()
         with _send_lock:
             try:
                 self._wait(lambda: ch.try_lock() == 0, timeout,
@@ -438,6 +488,10 @@ class Motion:
         return vals
 
     def _queue_end(self) -> Pose:
+        if self._last_end is not None:
+            head, tail, _ = self._ch.queue_state()
+            if head != tail:
+                return self._last_end
         st = self._ch.status()
         if st["queue_depth"] == 0 or self._last_end is None:
             return Pose(*st["carte_pos_cmd"])
@@ -456,7 +510,7 @@ class Motion:
                  acc: Optional[float] = None,
                  ini_maxvel: Optional[float] = None,
                  rapid: bool = False, id: Optional[int] = None,
-                 jerk: float = 0.0, flags: int = 0) -> int:
+                 jerk: float = 0.0, flags: int = 0, line: int = 0) -> int:
         """Queue a straight move to ``end`` (9 values, or a mapping of
         axis letters: the other axes stay where the last queued move
         ends).  ``vel`` is the requested path velocity; ``ini_maxvel`` the
@@ -466,7 +520,7 @@ class Motion:
         rapid scale applies).  Returns the motion id."""
         p = self._pose(end, "SET_LINE end")
         f = self._move_fields(vel, ini_maxvel, acc, id)
-        self.command(Cmd.SET_LINE, pos=p, jerk=jerk, ival=flags,
+        self.command(Cmd.SET_LINE, pos=p, jerk=jerk, ival=flags, line=line,
                      motion_type=int(MotionType.TRAVERSE if rapid
                                      else MotionType.FEED), **f)
         self._last_end = Pose(*p)
@@ -476,14 +530,14 @@ class Motion:
                    normal: Sequence[float], vel: float, *, turn: int = 0,
                    acc: Optional[float] = None,
                    ini_maxvel: Optional[float] = None,
-                   id: Optional[int] = None) -> int:
+                   id: Optional[int] = None, line: int = 0) -> int:
         """Queue an arc or helix to ``end`` around the axis through
         ``center`` along ``normal`` (counterclockwise seen from the tip of
         normal), with ``turn`` extra full turns.  Returns the motion id."""
         p = self._pose(end, "SET_CIRCLE end")
         f = self._move_fields(vel, ini_maxvel, acc, id)
         self.command(Cmd.SET_CIRCLE, pos=p, center=tuple(center),
-                     normal=tuple(normal), turn=turn,
+                     normal=tuple(normal), turn=turn, line=line,
                      motion_type=int(MotionType.ARC), **f)
         self._last_end = Pose(*p)
         return f["id"]
@@ -492,7 +546,7 @@ class Motion:
               acc: Optional[float] = None,
               ini_maxvel: Optional[float] = None, away: bool = False,
               error_if_no_contact: bool = True,
-              id: Optional[int] = None) -> int:
+              id: Optional[int] = None, line: int = 0) -> int:
         """Queue a probe move toward ``end``: it stops and records the
         position (status().probed_pos) when motion.probe-input trips (goes
         true; false with ``away``).  Without contact the move ends at
@@ -502,13 +556,195 @@ class Motion:
         f = self._move_fields(vel, ini_maxvel, acc, id)
         ptype = (PROBE_AWAY if away else 0) | \
             (0 if error_if_no_contact else PROBE_NO_ERROR)
-        self.command(Cmd.PROBE, pos=p, ival=ptype,
+        self.command(Cmd.PROBE, pos=p, ival=ptype, line=line,
                      motion_type=int(MotionType.PROBING), **f)
         self._last_end = Pose(*p)
         return f["id"]
 
     def clear_probe_flag(self) -> None:
         self.command(Cmd.CLEAR_PROBE_FLAG)
+
+    # the move queue
+
+    def _check_queue(self) -> None:
+        """Raise QueueRejected when motmod refused a queued record since
+        the last check (once per rejection)."""
+        try:
+            n, code, id, line, reason = self._ch.queue_error()
+        except _channel.ChannelError as e:
+            raise MotionError(str(e)) from None
+        if n != self._q_epoch:
+            self._q_epoch = n
+            self._last_end = None
+            try:
+                name = Cmd(code).name
+            except ValueError:
+                name = f"command {code}"
+            raise QueueRejected(name, reason or "no reason given", id, line)
+
+    def queue(self, cmd: Cmd, timeout: Optional[float] = None,
+              **fields: Any) -> None:
+        """Write one record (fields of mot_command_t) into the move queue
+        and return at once; blocks only while the queue is full (stepping
+        the servo thread when the client steps).  Raises QueueRejected
+        for an earlier queued record that motmod refused."""
+        cmd = Cmd(cmd)
+        ch = self._ch
+        self._check_queue()
+        with _send_lock:
+            try:
+                while True:
+                    r = ch.push(int(cmd), fields, self._q_epoch)
+                    if r == 0:
+                        return
+                    if r == 1:
+                        def room():
+                            self._check_queue()
+                            return ch.queue_free() > 0
+                        self._wait(room, timeout,
+                                   f"{cmd.name}: room in the move queue (is "
+                                   "motion-command-handler in a running "
+                                   "thread?)")
+                    else:
+                        self._wait(lambda: ch.try_lock() == 0 and
+                                   (ch.unlock() or True), timeout,
+                                   f"{cmd.name}: the channel lock (held by "
+                                   "another process)")
+            except _channel.ChannelError as e:
+                raise MotionError(str(e)) from None
+
+    def queue_free(self) -> int:
+        """Places free in the move queue (of MOVE_QUEUE_SIZE)."""
+        return self._ch.queue_free()
+
+    def queue_pending(self) -> int:
+        """Records written to the move queue and not yet taken by
+        motmod."""
+        head, tail, _ = self._ch.queue_state()
+        return (head - tail) & 0xFFFFFFFF
+
+    def queue_line(self, end: PoseLike, vel: float, *,
+                   acc: Optional[float] = None,
+                   ini_maxvel: Optional[float] = None,
+                   rapid: bool = False, id: Optional[int] = None,
+                   line: int = 0, jerk: float = 0.0, flags: int = 0) -> int:
+        """Like :meth:`set_line`, through the move queue: returns at once
+        (blocks only while the queue is full).  ``line`` is the program
+        line (motion.program-line while the move runs).  Returns the motion
+        id."""
+        p = self._pose(end, "SET_LINE end")
+        f = self._move_fields(vel, ini_maxvel, acc, id)
+        self.queue(Cmd.SET_LINE, pos=p, jerk=jerk, ival=flags, line=line,
+                   motion_type=int(MotionType.TRAVERSE if rapid
+                                   else MotionType.FEED), **f)
+        self._last_end = Pose(*p)
+        return f["id"]
+
+    def queue_circle(self, end: PoseLike, center: Sequence[float],
+                     normal: Sequence[float], vel: float, *, turn: int = 0,
+                     acc: Optional[float] = None,
+                     ini_maxvel: Optional[float] = None,
+                     id: Optional[int] = None, line: int = 0) -> int:
+        """Like :meth:`set_circle`, through the move queue."""
+        p = self._pose(end, "SET_CIRCLE end")
+        f = self._move_fields(vel, ini_maxvel, acc, id)
+        self.queue(Cmd.SET_CIRCLE, pos=p, center=tuple(center),
+                   normal=tuple(normal), turn=turn, line=line,
+                   motion_type=int(MotionType.ARC), **f)
+        self._last_end = Pose(*p)
+        return f["id"]
+
+    def queue_probe(self, end: PoseLike, vel: float, *,
+                    acc: Optional[float] = None,
+                    ini_maxvel: Optional[float] = None, away: bool = False,
+                    error_if_no_contact: bool = True,
+                    id: Optional[int] = None, line: int = 0) -> int:
+        """Like :meth:`probe`, through the move queue."""
+        p = self._pose(end, "PROBE end")
+        f = self._move_fields(vel, ini_maxvel, acc, id)
+        ptype = (PROBE_AWAY if away else 0) | \
+            (0 if error_if_no_contact else PROBE_NO_ERROR)
+        self.queue(Cmd.PROBE, pos=p, ival=ptype, line=line,
+                   motion_type=int(MotionType.PROBING), **f)
+        self._last_end = Pose(*p)
+        return f["id"]
+
+    def _sync_move(self, cmd: Cmd, end: PoseLike, pitch: float,
+                   vel: float, spindle: int, acc: Optional[float],
+                   ini_maxvel: Optional[float], id: Optional[int],
+                   line: int, queued: bool) -> int:
+        p = self._pose(end, f"{cmd.name} end")
+        f = self._move_fields(vel, ini_maxvel, acc, id)
+        args = dict(pos=p, pitch=pitch, index=spindle, line=line,
+                    motion_type=int(MotionType.FEED), **f)
+        if queued:
+            self.queue(cmd, **args)
+        else:
+            self.command(cmd, **args)
+        if cmd == Cmd.SPINDLE_SYNC_LINE:
+            self._last_end = Pose(*p)
+        return f["id"]
+
+    def queue_thread(self, end: PoseLike, pitch: float, *,
+                     vel: Optional[float] = None, spindle: int = 0,
+                     acc: Optional[float] = None,
+                     ini_maxvel: Optional[float] = None,
+                     id: Optional[int] = None, line: int = 0) -> int:
+        """A spindle-synchronized line (G33) to ``end``: ``pitch`` units
+        of path per spindle revolution, starting at the spindle's index.
+        ``vel`` bounds the path velocity (default: the velocity limit).
+        Needs the spindle turning (queue_spindle_on / spindle_on)."""
+        return self._sync_move(Cmd.SPINDLE_SYNC_LINE, end, pitch,
+                               vel or self._vel_limit(), spindle, acc,
+                               ini_maxvel, id, line, True)
+
+    def queue_rigid_tap(self, end: PoseLike, pitch: float, *,
+                        vel: Optional[float] = None, spindle: int = 0,
+                        acc: Optional[float] = None,
+                        ini_maxvel: Optional[float] = None,
+                        id: Optional[int] = None, line: int = 0) -> int:
+        """Rigid tapping (G33.1): in to ``end`` following the spindle with
+        ``pitch`` per revolution, the spindle reverses, the tool follows it
+        back out to the start."""
+        return self._sync_move(Cmd.RIGID_TAP, end, pitch,
+                               vel or self._vel_limit(), spindle, acc,
+                               ini_maxvel, id, line, True)
+
+    def _vel_limit(self) -> float:
+        v = self._ch.status()["vel_limit"]
+        if not v > 0:
+            raise ValueError("give vel= (no SET_VEL_LIMIT was sent)")
+        return v
+
+    def queue_dout(self, index: int, value: bool) -> None:
+        """Synchronized digital output (M62/M63): changes when the next
+        queued move starts."""
+        self.queue(Cmd.SET_DOUT, index=index, ival=1 if value else 0, sync=1)
+
+    def queue_aout(self, index: int, value: float) -> None:
+        """Synchronized analog output (M67): changes when the next queued
+        move starts."""
+        self.queue(Cmd.SET_AOUT, index=index, value=value, sync=1)
+
+    def queue_term_cond(self, cond: Union[TermCond, int],
+                        tolerance: float = 0.0,
+                        cam_tolerance: float = 0.0) -> None:
+        """:meth:`set_term_cond` in order with the queued moves (G61,
+        G61.1, G64 P Q)."""
+        self.queue(Cmd.SET_TERM_COND, ival=int(cond), tolerance=tolerance,
+                   value=cam_tolerance)
+
+    def queue_spindle_on(self, speed: float, spindle: int = 0, **css: Any
+                         ) -> None:
+        """:meth:`spindle_on` in order with the queued moves (taken when
+        the moves before it are in the planner, as the reference's M3/M4
+        are); the next feed move waits for spindle.N.at-speed."""
+        self.queue(Cmd.SPINDLE_ON, **_spindle_on_fields(speed, spindle,
+                                                        **css))
+
+    def queue_spindle_off(self, spindle: int = 0) -> None:
+        """:meth:`spindle_off` in order with the queued moves."""
+        self.queue(Cmd.SPINDLE_OFF, index=spindle)
 
     def set_teleop_vector(self, vel: PoseLike) -> None:
         """Teleop mode: move with this velocity of each axis (9 values or
@@ -627,8 +863,13 @@ class Motion:
         self.command(Cmd.SET_ACC, acc=acc)
 
     def set_term_cond(self, cond: Union[TermCond, int],
-                      tolerance: float = 0.0) -> None:
-        self.command(Cmd.SET_TERM_COND, ival=int(cond), tolerance=tolerance)
+                      tolerance: float = 0.0,
+                      cam_tolerance: float = 0.0) -> None:
+        """End of coordinated moves: STOP (G61.1), EXACT (G61), BLEND
+        with ``tolerance`` (G64 P) and ``cam_tolerance`` (G64 Q).  For
+        moves already in the move queue use :meth:`queue_term_cond`."""
+        self.command(Cmd.SET_TERM_COND, ival=int(cond), tolerance=tolerance,
+                     value=cam_tolerance)
 
     def set_tool_offset(self, offset: PoseLike) -> None:
         """The tool offset (9 values or a mapping of axis letters, others
@@ -654,13 +895,117 @@ class Motion:
                                  "or jerk)") from None
         self.command(Cmd.SET_PROFILE, ival=int(profile))
 
-    def set_dout(self, index: int, value: bool) -> None:
-        """Set motion.digital-out-NN now."""
-        self.command(Cmd.SET_DOUT, index=index, ival=1 if value else 0)
+    def set_dout(self, index: int, value: bool, sync: bool = False
+                 ) -> None:
+        """Set motion.digital-out-NN now (M64/M65), or with ``sync`` when
+        the next queued move starts (M62/M63; see also
+        :meth:`queue_dout`)."""
+        self.command(Cmd.SET_DOUT, index=index, ival=1 if value else 0,
+                     sync=1 if sync else 0)
 
-    def set_aout(self, index: int, value: float) -> None:
-        """Set motion.analog-out-NN now."""
-        self.command(Cmd.SET_AOUT, index=index, value=value)
+    def set_aout(self, index: int, value: float, sync: bool = False
+                 ) -> None:
+        """Set motion.analog-out-NN now (M68), or with ``sync`` when the
+        next queued move starts (M67; see also :meth:`queue_aout`)."""
+        self.command(Cmd.SET_AOUT, index=index, value=value,
+                     sync=1 if sync else 0)
+
+    # feed control
+
+    def set_feed_hold_enable(self, on: bool = True) -> None:
+        """M53: motion.feed-hold stops coordinated motion only while
+        enabled (the default)."""
+        self.command(Cmd.SET_FEED_HOLD_ENABLE, ival=1 if on else 0)
+
+    def set_adaptive_feed_enable(self, on: bool = True) -> None:
+        """M52: motion.adaptive-feed scales the feed only while enabled
+        (off by default)."""
+        self.command(Cmd.SET_ADAPTIVE_FEED_ENABLE, ival=1 if on else 0)
+
+    def set_linear_units(self, units: Union[str, float]) -> None:
+        """The machine's length unit ([TRAJ]LINEAR_UNITS): "mm", "inch"
+        (also "in", "cm", "metric", "imperial") or millimetres per unit;
+        the mm and inch feed pins need it."""
+        if isinstance(units, str):
+            try:
+                mm = LINEAR_UNITS[units.strip().lower()]
+            except KeyError:
+                raise ValueError(f"unknown linear units {units!r} (mm, "
+                                 "inch, cm or a number of mm)") from None
+        else:
+            mm = float(units)
+        self.command(Cmd.SET_LINEAR_UNITS, value=mm)
+
+    # spindles
+
+    def spindle_on(self, speed: float, spindle: int = 0, *,
+                   css: float = 0.0, css_axis: JointOrAxis = "x",
+                   css_max: float = 0.0) -> None:
+        """Turn a spindle on at ``speed`` rpm (negative: reverse, M4).
+        With ``css`` (surface speed, units per minute) the speed follows
+        the radius on ``css_axis`` up to ``css_max`` rpm (G96).  The next
+        feed move waits for spindle.N.at-speed."""
+        self.command(Cmd.SPINDLE_ON, **_spindle_on_fields(
+            speed, spindle, css=css, css_axis=css_axis, css_max=css_max))
+
+    def spindle_off(self, spindle: int = 0) -> None:
+        """Stop a spindle (M5): speed 0, brake on."""
+        self.command(Cmd.SPINDLE_OFF, index=spindle)
+
+    def spindle_increase(self, spindle: int = 0, step: float = 0.0) -> None:
+        """Faster by ``step`` rpm (0: by 10 %)."""
+        self.command(Cmd.SPINDLE_INCREASE, index=spindle, value=step)
+
+    def spindle_decrease(self, spindle: int = 0, step: float = 0.0) -> None:
+        """Slower by ``step`` rpm (0: by 10 %); refused if it would stop."""
+        self.command(Cmd.SPINDLE_DECREASE, index=spindle, value=step)
+
+    def spindle_orient(self, angle: float, mode: int = 0, spindle: int = 0,
+                       *, wait: bool = False,
+                       timeout: Optional[float] = None) -> None:
+        """M19: stop the spindle and ask the drive to orient it to
+        ``angle`` (spindle.N.orient, -angle, -mode).  With ``wait``, wait
+        until spindle.N.is-oriented (locked, brake on); an orient fault
+        raises MotionError."""
+        self.command(Cmd.SPINDLE_ORIENT, index=spindle, value=angle,
+                     ival=mode)
+        if wait:
+            self.wait_oriented(spindle, timeout)
+
+    def wait_oriented(self, spindle: int = 0,
+                      timeout: Optional[float] = None) -> Status:
+        """Wait for the end of an orient; raises MotionError on an orient
+        fault."""
+        def done(d: dict) -> bool:
+            sp = d["spindles"][spindle]
+            if sp["orient_state"] == 3:
+                self._pull_messages()
+                raise MotionError(f"spindle {spindle} orient failed "
+                                  f"(orient-fault {sp['orient_fault']})")
+            return sp["orient_state"] == 2
+        return self._wait_raw(done, timeout, f"spindle {spindle} oriented")
+
+    def spindle_brake(self, engage: bool = True, spindle: int = 0) -> None:
+        """Engage (refused while it turns) or release the brake."""
+        self.command(Cmd.SPINDLE_BRAKE_ENGAGE if engage
+                     else Cmd.SPINDLE_BRAKE_RELEASE, index=spindle)
+
+    def spindle_sync_line(self, end: PoseLike, pitch: float, *,
+               vel: Optional[float] = None, spindle: int = 0,
+               id: Optional[int] = None, line: int = 0) -> int:
+        """G33 (:meth:`queue_thread`) through the command mailbox (waits
+        for motmod's answer)."""
+        return self._sync_move(Cmd.SPINDLE_SYNC_LINE, end, pitch,
+                               vel or self._vel_limit(), spindle, None,
+                               None, id, line, False)
+
+    def rigid_tap(self, end: PoseLike, pitch: float, *,
+                  vel: Optional[float] = None, spindle: int = 0,
+                  id: Optional[int] = None, line: int = 0) -> int:
+        """:meth:`queue_rigid_tap` through the command mailbox."""
+        return self._sync_move(Cmd.RIGID_TAP, end, pitch,
+                               vel or self._vel_limit(), spindle, None,
+                               None, id, line, False)
 
     def configure(self, joints: Sequence[Mapping[str, Any]] = (),
                   axes: Optional[Mapping[str, Mapping[str, Any]]] = None,
@@ -763,15 +1108,88 @@ class Motion:
     def wait_done(self, timeout: Optional[float] = None) -> Status:
         """Wait until the coordinated queue is empty and everything is at
         rest; raises MotionError if motion got disabled meanwhile."""
+        self._check_queue()
+        head = self._ch.queue_state()[0]
+
         def done(d: dict) -> bool:
+            if d["queue_err_count"] != self._q_epoch:
+                self._check_queue()
             if not d["enabled"]:
                 self._pull_messages()
                 raise MotionError(
                     "motion was disabled while waiting for the moves to "
                     "finish" + _because(self._pending))
-            return (d["in_position"] and d["queue_depth"] == 0
-                    and not d["homing"])
+            return (d["queue_taken"] == head and d["in_position"]
+                    and d["queue_depth"] == 0 and not d["homing"])
         return self._wait_raw(done, timeout, "the end of the moves")
+
+    def wait_input(self, kind: str, index: int,
+                   mode: Union[InputWait, int, str] = InputWait.IMMEDIATE,
+                   timeout: Optional[float] = None
+                   ) -> Union[bool, float, None]:
+        """M66: wait for motion.digital-in-NN (``kind`` "digital") or read
+        motion.analog-in-NN ("analog").  ``mode``: IMMEDIATE (the value
+        now), RISE, FALL (an edge after the call), HIGH, LOW (the level;
+        true at once if it already holds) — digital inputs only.  Returns
+        the input's value in the cycle the condition held, or None when
+        ``timeout`` (seconds, simulated when stepping) passed first (the
+        reference's -1).  The inputs are read from the status, every servo
+        cycle when the client steps."""
+        if isinstance(mode, str):
+            try:
+                mode = InputWait[mode.upper()]
+            except KeyError:
+                raise ValueError(f"unknown wait mode {mode!r} (immediate, "
+                                 "rise, fall, high, low)") from None
+        mode = InputWait(mode)
+        kind = kind.lower()
+        if kind not in ("digital", "analog"):
+            raise ValueError(f"input kind must be 'digital' or 'analog', "
+                             f"got {kind!r}")
+        d = self._ch.status()
+        n = d["num_dio"] if kind == "digital" else d["num_aio"]
+        if not 0 <= index < n:
+            raise ValueError(f"{kind} input {index} does not exist "
+                             f"(num_{'dio' if kind == 'digital' else 'aio'}"
+                             f"={n})")
+        if kind == "analog":
+            if mode != InputWait.IMMEDIATE:
+                raise ValueError("analog inputs can only be read "
+                                 "(mode IMMEDIATE)")
+            return d["ain"][index]
+
+        def bit(d: dict) -> bool:
+            return bool((d["din"] >> index) & 1)
+
+        last = [bit(d)]
+        if mode == InputWait.IMMEDIATE:
+            return last[0]
+        if timeout is None:
+            timeout = self.timeout
+        if timeout < 0 or not math.isfinite(timeout):
+            raise ValueError(f"timeout must be >= 0 seconds, got {timeout}")
+
+        def cond():
+            v = bit(self._ch.status())
+            prev, last[0] = last[0], v
+            if mode == InputWait.HIGH:
+                return v or None
+            if mode == InputWait.LOW:
+                return (not v) or None
+            if mode == InputWait.RISE:
+                return (v and not prev) or None
+            return (prev and not v) or None
+
+        if mode in (InputWait.HIGH, InputWait.LOW) and \
+                last[0] == (mode == InputWait.HIGH):
+            return last[0]
+        if timeout == 0:
+            return None
+        try:
+            self._wait(cond, timeout, f"digital input {index}")
+        except MotionTimeout:
+            return None
+        return last[0]
 
     def wait_homed(self, joints: Optional[Iterable[int]] = None,
                    timeout: Optional[float] = None) -> Status:
@@ -803,6 +1221,13 @@ class Motion:
     @property
     def mode(self) -> Mode:
         return self.status().mode
+
+
+def _spindle_on_fields(speed: float, spindle: int = 0, *,
+                       css: float = 0.0, css_axis: JointOrAxis = "x",
+                       css_max: float = 0.0) -> dict:
+    return dict(index=spindle, vel=speed, value=css, ival=_axis(css_axis),
+                offset=css_max)
 
 
 def _because(errors: Sequence[str]) -> str:

@@ -180,6 +180,45 @@ class AxisStatus:
                    jerk_limit=d["jerk_limit"])
 
 
+class OrientState(enum.IntEnum):
+    """Where a spindle's orient (M19) is."""
+    NONE = 0
+    RUNNING = 1     #: spindle.N.orient is true, waiting for is-oriented
+    DONE = 2        #: oriented: locked and braked
+    FAULT = 3       #: spindle.N.orient-fault was not 0
+
+
+@dataclass(frozen=True)
+class SpindleStatus:
+    """One spindle."""
+    index: int
+    on: bool                    #: spindle.N.on
+    direction: int              #: 1 forward, -1 reverse, 0 stopped
+    speed: float                #: spindle.N.speed-out, rpm (signed)
+    speed_in: float             #: spindle.N.speed-in, rev/s
+    revs: float                 #: spindle.N.revs
+    at_speed: bool
+    brake: bool
+    locked: bool                #: oriented and held
+    orient_state: OrientState
+    orient_angle: float
+    orient_fault: int
+    inhibit: bool
+    amp_fault: bool
+    css_factor: float           #: CSS surface speed (0: off)
+
+    @classmethod
+    def from_dict(cls, index: int, d: dict) -> SpindleStatus:
+        return cls(index=index, on=d["on"], direction=d["direction"],
+                   speed=d["speed"], speed_in=d["speed_in"],
+                   revs=d["revs"], at_speed=d["at_speed"],
+                   brake=d["brake"], locked=d["locked"],
+                   orient_state=_enum(OrientState, d["orient_state"]),
+                   orient_angle=d["orient_angle"],
+                   orient_fault=d["orient_fault"], inhibit=d["inhibit"],
+                   amp_fault=d["amp_fault"], css_factor=d["css_factor"])
+
+
 def _enum(cls, value):
     try:
         return cls(value)
@@ -235,6 +274,20 @@ class Status:
     num_spindles: int
     dout: int
     din: int
+    program_line: int           #: line of the running move (0: idle)
+    feed_hold_enabled: bool     #: M53: motion.feed-hold applies
+    adaptive_enabled: bool      #: M52: motion.adaptive-feed applies
+    feed_hold: bool             #: feed hold in force now
+    feed_inhibit: bool          #: motion.feed-inhibit is true
+    adaptive_feed: float        #: motion.adaptive-feed
+    feed_upm: float             #: motion.feed-upm
+    linear_units: float         #: mm per length unit (0: not set)
+    ain: tuple                  #: motion.analog-in-NN
+    aout: tuple                 #: motion.analog-out-NN
+    spindles: tuple             #: SpindleStatus of each spindle
+    spindle_wait: int           #: the planner waits: 1 at-speed, 2 index
+    at_speed_wait: bool         #: a feed move waits for spindle at-speed
+    queue_taken: int            #: move-queue records motmod took (mod 2**32)
     errors: tuple               #: messages not yet taken by errors()
 
     @classmethod
@@ -275,4 +328,16 @@ class Status:
             servo_period=d["servo_period"], traj_period=d["traj_period"],
             num_dio=d["num_dio"], num_aio=d["num_aio"],
             num_spindles=d["num_spindles"], dout=d["dout"], din=d["din"],
+            program_line=d["program_line"],
+            feed_hold_enabled=d["feed_hold_enabled"],
+            adaptive_enabled=d["adaptive_enabled"],
+            feed_hold=d["feed_hold"], feed_inhibit=d["feed_inhibit"],
+            adaptive_feed=d["adaptive_feed"], feed_upm=d["feed_upm"],
+            linear_units=d["linear_units"], ain=tuple(d["ain"]),
+            aout=tuple(d["aout"]),
+            spindles=tuple(SpindleStatus.from_dict(i, sp)
+                           for i, sp in enumerate(d["spindles"])),
+            queue_taken=d["queue_taken"],
+            spindle_wait=d["spindle_wait"],
+            at_speed_wait=d["queue_held"],
             errors=tuple(errors))
