@@ -12,9 +12,7 @@ import pytest
 from motion_trace import looped_machine
 
 from halsdk.motion import (
-    Cmd,
     MotionError,
-    MotionTimeout,
     OrientState,
     Rejected,
 )
@@ -235,17 +233,27 @@ def test_spindle_off_cancels_the_wait(hal, m):
 
 
 def test_mailbox_feed_move_after_spindle_on_waits_too(hal, m):
-    """Through the mailbox the move is not taken (no answer) until the
-    spindle is at speed."""
+    """Through the mailbox the move is answered at once and held until the
+    spindle is at speed; meanwhile the mailbox stays free (ABORT gets
+    through and drops the held move)."""
     hal.setp("spindle.0.at-speed", False)
     m.spindle_on(400)
-    with pytest.raises(MotionTimeout, match="SET_LINE: motmod's answer"):
-        m.command(Cmd.SET_LINE, timeout=0.2, pos=xyz(x=1.0), vel=20.0,
-                  motion_type=2)
+    m.set_line(xyz(x=1.0), vel=20.0)
+    hal.step(50)
     assert m.status().carte_pos_cmd.x == 0.0
+    with pytest.raises(Rejected, match="already waits for the spindle"):
+        m.set_line(xyz(x=2.0), vel=20.0)
     hal.setp("spindle.0.at-speed", True)
     st = m.wait_for(lambda s: s.carte_pos_cmd.x == 1.0 and s.in_position)
     assert st.queue_depth == 0
+    # a new speed, a held move, then ABORT: the move never runs
+    hal.setp("spindle.0.at-speed", False)
+    m.spindle_on(800)
+    m.set_line(xyz(x=3.0), vel=20.0)
+    m.abort()
+    hal.setp("spindle.0.at-speed", True)
+    hal.step(500)
+    assert m.status().carte_pos_cmd.x == 1.0
 
 
 # ------------------------------------------------------------ G33, G33.1

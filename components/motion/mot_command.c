@@ -513,39 +513,48 @@ static int move_args(const mot_command_t *c, tp_move_t *m)
     return 0;
 }
 
-static int cmd_move(const mot_command_t *c)
+/* all checks of a move command before it goes to the planner */
+static int check_move(const mot_command_t *c, tp_move_t *m)
 {
-    tp_move_t m;
-    char w[MOT_REASON_LEN];
     int r;
 
-    if ((r = move_args(c, &m)))
+    if ((r = move_args(c, m)))
         return r;
-    w[0] = 0;
-    if (c->cmd == MOT_CMD_SET_LINE) {
-        r = mot->tp->add_line(&c->pos, &m, w, sizeof(w));
-    } else if (c->cmd == MOT_CMD_SET_CIRCLE) {
+    if (c->cmd == MOT_CMD_SET_CIRCLE) {
         if ((r = bad_cart("center", &c->center)))
             return r;
         if ((r = bad_cart("normal", &c->normal)))
             return r;
         if (c->normal.x == 0 && c->normal.y == 0 && c->normal.z == 0)
             return reject("SET_CIRCLE: the normal must not be (0, 0, 0)");
+    } else if (c->cmd == MOT_CMD_PROBE && mot->probe_tripped) {
+        return reject("PROBE: the probe flag is still set (send "
+                      "CLEAR_PROBE_FLAG first)");
+    } else if (c->cmd == MOT_CMD_RIGID_TAP && !mot->tp->add_rigid_tap) {
+        return reject("RIGID_TAP: the trajectory planner cannot do "
+                      "rigid tapping");
+    }
+    return 0;
+}
+
+static int cmd_move(const mot_command_t *c)
+{
+    tp_move_t m;
+    char w[MOT_REASON_LEN];
+    int r;
+
+    if ((r = check_move(c, &m)))
+        return r;
+    w[0] = 0;
+    if (c->cmd == MOT_CMD_SET_LINE || c->cmd == MOT_CMD_SPINDLE_SYNC_LINE)
+        r = mot->tp->add_line(&c->pos, &m, w, sizeof(w));
+    else if (c->cmd == MOT_CMD_SET_CIRCLE)
         r = mot->tp->add_circle(&c->pos, &c->center, &c->normal, c->turn,
                                 &m, w, sizeof(w));
-    } else if (c->cmd == MOT_CMD_PROBE) {
-        if (mot->probe_tripped)
-            return reject("PROBE: the probe flag is still set (send "
-                          "CLEAR_PROBE_FLAG first)");
+    else if (c->cmd == MOT_CMD_PROBE)
         r = mot->tp->add_probe(&c->pos, &m, c->ival, w, sizeof(w));
-    } else if (c->cmd == MOT_CMD_SPINDLE_SYNC_LINE) {
-        r = mot->tp->add_line(&c->pos, &m, w, sizeof(w));
-    } else {
-        if (!mot->tp->add_rigid_tap)
-            return reject("RIGID_TAP: the trajectory planner cannot do "
-                          "rigid tapping");
+    else
         r = mot->tp->add_rigid_tap(&c->pos, &m, w, sizeof(w));
-    }
     if (r < 0)
         return reject("%s: %s", cmd_name(c->cmd),
                       w[0] ? w : "the trajectory planner refused it");
@@ -1284,6 +1293,7 @@ static int spindles_at_speed(void)
 void mot_queue_drop(void)
 {
     mot_channel_t *ch = mot->chan;
+    mot->deferred_valid = 0;            /* a held mailbox move goes too */
     if (!ch)
         return;
     __atomic_store_n(&ch->q_tail, __atomic_load_n(&ch->q_head,
@@ -1359,6 +1369,31 @@ static void drain_queue(mot_channel_t *ch)
     __atomic_store_n(&ch->q_tail, tail, __ATOMIC_RELEASE);
 }
 
+/* hand the held mailbox move to the planner once its wait is over (or
+   was cancelled by SPINDLE_OFF); a refusal then is posted */
+static void run_deferred(void)
+{
+    char w[MOT_REASON_LEN];
+
+    if (!mot->deferred_valid)
+        return;
+    if (!mot->enabled || mot->mode != MOT_MODE_COORD) {
+        mot->deferred_valid = 0;
+        return;
+    }
+    if (mot->wait_at_speed && (!mot->tp_done || !spindles_at_speed()))
+        return;
+    mot->deferred_valid = 0;
+    mot->wait_at_speed = 0;
+    why = w;
+    whylen = sizeof(w);
+    w[0] = 0;
+    if (run_command(&mot->deferred) == MOT_ECHO_REJECTED)
+        mot_post("%s (id %d, line %d), held until the spindle was at "
+                 "speed, was refused: %s", cmd_name(mot->deferred.cmd),
+                 mot->deferred.id, mot->deferred.line, w);
+}
+
 void mot_command_handler(void *arg, long period)
 {
     mot_channel_t *ch = mot->chan;
@@ -1370,28 +1405,36 @@ void mot_command_handler(void *arg, long period)
     (void)period;
     if (!ch)
         return;
+    run_deferred();
     seq = __atomic_load_n(&ch->cmd_seq, __ATOMIC_ACQUIRE);
     if (seq == mot->last_seq) {
         drain_queue(ch);
         return;
     }
     memcpy(&c, (const void *)&ch->command, sizeof(c));
-    if (mot->wait_at_speed && waits_for_spindle(&c) && mot->enabled
-        && mot->mode == MOT_MODE_COORD) {
-        /* a feed move after a spindle start: taken (and echoed) once the
-           planner has run out and the spindles are at speed */
-        if (!mot->tp_done || !spindles_at_speed()) {
-            drain_queue(ch);
-            return;
-        }
-        mot->wait_at_speed = 0;
-    }
     mot->last_seq = seq;
 
     why = ch->echo_reason;
     whylen = sizeof(ch->echo_reason);
     why[0] = 0;
-    st = run_command(&c);
+    if (mot->wait_at_speed && waits_for_spindle(&c) && mot->enabled
+        && mot->mode == MOT_MODE_COORD) {
+        /* a feed move after a spindle start runs once the planner has
+           run out and the spindles are at speed: answer now (ABORT must
+           get through meanwhile) and hold the move */
+        tp_move_t m;
+        if (mot->deferred_valid)
+            st = reject("%s: a feed move already waits for the spindle to "
+                        "reach speed", cmd_name(c.cmd));
+        else if ((st = check_move(&c, &m)) == MOT_ECHO_REJECTED)
+            ;                           /* checked now, not after the wait */
+        else {
+            mot->deferred = c;
+            mot->deferred_valid = 1;
+            st = MOT_ECHO_ACCEPTED;
+        }
+    } else
+        st = run_command(&c);
     if (st != MOT_ECHO_REJECTED)
         why[0] = 0;
     ch->echo_status = st;

@@ -1179,7 +1179,8 @@ void mot_write_status(void)
     s->paused = mot->tp_paused;
     s->probing = mot->tp_probing;
     s->probe_tripped = mot->probe_tripped;
-    s->queue_depth = mot->queue_depth;
+    /* a mailbox move held for at-speed counts as queued */
+    s->queue_depth = mot->queue_depth + mot->deferred_valid;
     s->motion_id = mot->motion_id;
     s->motion_type = *mot->mp->motion_type;
     s->profile = mot->profile;

@@ -289,6 +289,10 @@ typedef struct {
     int tp_spindle_wait;        /* the planner waits for the spindle */
     int wait_at_speed;          /* a spindle started or changed speed:
                                    the next feed move waits */
+    mot_command_t deferred;     /* a feed move from the mailbox that waits
+                                   for at-speed: answered at once, handed
+                                   to the planner when the wait is over */
+    int deferred_valid;
     mot_spindle_t spindle[MOT_MAX_SPINDLES];
 
     mot_joint_t *joints;        /* num_joints */
