@@ -11,6 +11,7 @@
 #include "hal_core.h"
 
 #include <errno.h>
+#include <stddef.h>
 #include <fcntl.h>
 #include <fnmatch.h>
 #include <stdarg.h>
@@ -1311,8 +1312,62 @@ static void delete_items_of(hoff_t comp, hoff_t inst)
     FOR_EACH(K_PARAM, hal_item_t, it)
         if (it->comp == comp && (!inst || it->inst == inst))
             item_delete(it);
-    hal_stream_delete_of(comp, inst);
-    hal_shmem_delete_of(comp, inst);
+    hal_delete_owned(K_STREAM, comp, inst);
+    hal_delete_owned(K_SHMEM, comp, inst);
+}
+
+long long hal_handle_of(const hal_obj_t *o)
+{
+    return ((long long)o->gen << 32) | (long long)SHMOFF(o);
+}
+
+void *hal_handle_get(long long handle, int kind, size_t size)
+{
+    hal_header_t *h = hal_map.hdr;
+    if (!h || handle < 0)
+        return NULL;
+    hoff_t off = (hoff_t)(handle & 0xffffffffLL);
+    uint32_t gen = (uint32_t)((unsigned long long)handle >> 32);
+    if (off < h->heap_start || off + size > h->heap_end)
+        return NULL;
+    hal_obj_t *o = SHMPTR(off);
+    if (__atomic_load_n(&o->kind, __ATOMIC_ACQUIRE) != kind ||
+        o->gen != gen)
+        return NULL;
+    return o;
+}
+
+long long hal_handle_attach(int kind, const char *name)
+{
+    if (!name || !*name)
+        return hal_fail(EINVAL, "%s name is empty", kind_word(kind));
+    int r = hal_lock();
+    if (r)
+        return r;
+    hal_obj_t *o = hal_find(kind, name);
+    long long ret = o ? hal_handle_of(o)
+                      : hal_fail(ENOENT, "%s '%s' not found",
+                                 kind_word(kind), name);
+    hal_unlock();
+    return ret;
+}
+
+/* streams and shared blocks begin as hal_owned_t does */
+_Static_assert(offsetof(hal_stream_t, comp) == offsetof(hal_owned_t, comp)
+               && offsetof(hal_stream_t, inst) == offsetof(hal_owned_t, inst)
+               && offsetof(hal_shmem_t, comp) == offsetof(hal_owned_t, comp)
+               && offsetof(hal_shmem_t, inst) == offsetof(hal_owned_t, inst),
+               "owned objects begin with hal_owned_t");
+
+void hal_delete_owned(int kind, hoff_t comp, hoff_t inst)
+{
+    hal_header_t *h = hal_map.hdr;
+    for (hoff_t off = h->list_head[kind]; off;) {
+        hal_owned_t *o = SHMPTR(off);
+        off = o->o.next;
+        if (o->comp == comp && (!inst || o->inst == inst))
+            hal_obj_delete(&o->o);
+    }
 }
 
 int hal_owner(int owner_id, const char *what, hoff_t *comp, hoff_t *inst)

@@ -304,7 +304,6 @@ int hal_check_consistency(char *report, int len);
 void *hal_obj_new(int kind, long size, const char *name);
 void hal_obj_publish(hal_obj_t *o);
 void hal_obj_delete(hal_obj_t *o);
-void hal_stream_delete_of(hoff_t comp, hoff_t inst);   /* lock held */
 long long hal_stream_create(const char *name, int owner_id, int depth,
                             const char *typestring);
 long long hal_stream_attach(const char *name);
@@ -321,6 +320,22 @@ int hal_stream_elem_type(long long handle, int index);
 int hal_stream_parse_types(const char *typestring, uint8_t *types,
                            const char *what);
 
+/*
+ * Objects a component owns and other code holds by handle (streams,
+ * shared blocks) begin with hal_owned_t.  A handle packs generation and
+ * offset, (gen << 32) | off, so a handle of a deleted object is seen as
+ * stale instead of reading whatever was allocated in its place.
+ */
+typedef struct {
+    hal_obj_t o;
+    hoff_t comp, inst;          /* owner: deleted with it */
+} hal_owned_t;
+
+long long hal_handle_of(const hal_obj_t *o);
+void *hal_handle_get(long long handle, int kind, size_t size);  /* or NULL */
+long long hal_handle_attach(int kind, const char *name);  /* takes the lock */
+void hal_delete_owned(int kind, hoff_t comp, hoff_t inst);  /* lock held */
+
 /* lock held: the component (and instance, if owner_id is one) that
    owner_id names, which must belong to this process; 0 or -errno with
    the error set, the message starting with what */
@@ -331,7 +346,6 @@ long long hal_shmem_new(const char *name, int owner_id, long size);
 long long hal_shmem_attach(const char *name);
 void *hal_shmem_ptr(long long handle);
 long hal_shmem_size(long long handle);
-void hal_shmem_delete_of(hoff_t comp, hoff_t inst);
 
 /* symbols between realtime modules (hal_symbol.c) */
 int hal_symbol_export(const char *name, void *addr, const char *module);

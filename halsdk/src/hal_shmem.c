@@ -3,9 +3,9 @@
  * a realtime module shares with other processes (the motion module's
  * command and status channel), found by name like any other object.
  *
- * Handles pack generation and offset like stream handles, so a handle of
- * a deleted block is seen as stale.  The data is zeroed at creation and
- * aligned to 64 bytes; what goes on inside is the owner's protocol.
+ * Blocks are held by handle (hal_handle_get, hal_core.h).  The data is
+ * zeroed at creation and aligned to 64 bytes; what goes on inside is the
+ * owner's protocol.
  */
 #define _GNU_SOURCE
 #include "hal_core.h"
@@ -17,25 +17,9 @@
 
 #define ALIGN 64
 
-static long long handle_of(hal_shmem_t *b)
-{
-    return ((long long)b->o.gen << 32) | (long long)SHMOFF(b);
-}
-
 static hal_shmem_t *block_of(long long handle)
 {
-    hal_header_t *h = hal_map.hdr;
-    if (!h || handle < 0)
-        return NULL;
-    hoff_t off = (hoff_t)(handle & 0xffffffffLL);
-    uint32_t gen = (uint32_t)((unsigned long long)handle >> 32);
-    if (off < h->heap_start || off + sizeof(hal_shmem_t) > h->heap_end)
-        return NULL;
-    hal_shmem_t *b = SHMPTR(off);
-    if (__atomic_load_n(&b->o.kind, __ATOMIC_ACQUIRE) != K_SHMEM ||
-        b->o.gen != gen)
-        return NULL;
-    return b;
+    return hal_handle_get(handle, K_SHMEM, sizeof(hal_shmem_t));
 }
 
 long long hal_shmem_new(const char *name, int owner_id, long size)
@@ -76,7 +60,7 @@ long long hal_shmem_new(const char *name, int owner_id, long size)
     b->data = data;
     b->size = (uint64_t)size;
     hal_obj_publish(&b->o);
-    ret = handle_of(b);
+    ret = hal_handle_of(&b->o);
 out:
     hal_unlock();
     return ret;
@@ -84,17 +68,7 @@ out:
 
 long long hal_shmem_attach(const char *name)
 {
-    if (!name || !*name)
-        return hal_fail(EINVAL, "shared block name is empty");
-    int r = hal_lock();
-    if (r)
-        return r;
-    hal_shmem_t *b = hal_find(K_SHMEM, name);
-    long long ret = b ? handle_of(b)
-                      : hal_fail(ENOENT, "shared block '%s' not found",
-                                 name);
-    hal_unlock();
-    return ret;
+    return hal_handle_attach(K_SHMEM, name);
 }
 
 void *hal_shmem_ptr(long long handle)
@@ -107,17 +81,4 @@ long hal_shmem_size(long long handle)
 {
     hal_shmem_t *b = block_of(handle);
     return b ? (long)b->size : -ENOENT;
-}
-
-/* lock held: remove the blocks of a component (inst == 0) or of one of
-   its instances */
-void hal_shmem_delete_of(hoff_t comp, hoff_t inst)
-{
-    hal_header_t *h = hal_map.hdr;
-    for (hoff_t o = h->list_head[K_SHMEM]; o;) {
-        hal_shmem_t *b = SHMPTR(o);
-        o = b->o.next;
-        if (b->comp == comp && (!inst || b->inst == inst))
-            hal_obj_delete(&b->o);
-    }
 }

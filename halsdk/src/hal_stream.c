@@ -10,9 +10,7 @@
  * record once it sees the index (acquire load).  Nothing on that path
  * allocates, locks or makes a system call.
  *
- * A handle packs the record's generation and offset, (gen << 32) | off,
- * so a handle of a deleted stream is recognised as stale instead of
- * reading whatever was allocated in its place.
+ * Streams are held by handle (hal_handle_get, hal_core.h).
  */
 #define _GNU_SOURCE
 #include "hal_core.h"
@@ -57,25 +55,9 @@ int hal_stream_parse_types(const char *typestring, uint8_t *types,
     return n;
 }
 
-static long long handle_of(hal_stream_t *s)
-{
-    return ((long long)s->o.gen << 32) | (long long)SHMOFF(s);
-}
-
 hal_stream_t *hal_stream_get(long long handle)
 {
-    hal_header_t *h = hal_map.hdr;
-    if (!h || handle < 0)
-        return NULL;
-    hoff_t off = (hoff_t)(handle & 0xffffffffLL);
-    uint32_t gen = (uint32_t)((unsigned long long)handle >> 32);
-    if (off < h->heap_start || off + sizeof(hal_stream_t) > h->heap_end)
-        return NULL;
-    hal_stream_t *s = SHMPTR(off);
-    if (__atomic_load_n(&s->o.kind, __ATOMIC_ACQUIRE) != K_STREAM ||
-        s->o.gen != gen)
-        return NULL;
-    return s;
+    return hal_handle_get(handle, K_STREAM, sizeof(hal_stream_t));
 }
 
 static int stale(void)
@@ -128,7 +110,7 @@ long long hal_stream_create(const char *name, int owner_id, int depth,
     s->stride = (uint32_t)stride;
     memcpy(s->types, types, (size_t)n);
     hal_obj_publish(&s->o);
-    ret = handle_of(s);
+    ret = hal_handle_of(&s->o);
 out:
     hal_unlock();
     return ret;
@@ -136,29 +118,7 @@ out:
 
 long long hal_stream_attach(const char *name)
 {
-    if (!name || !*name)
-        return hal_fail(EINVAL, "stream name is empty");
-    int r = hal_lock();
-    if (r)
-        return r;
-    hal_stream_t *s = hal_find(K_STREAM, name);
-    long long ret = s ? handle_of(s)
-                      : hal_fail(ENOENT, "stream '%s' not found", name);
-    hal_unlock();
-    return ret;
-}
-
-/* lock held: remove the streams of a component (inst == 0) or of one of
-   its instances */
-void hal_stream_delete_of(hoff_t comp, hoff_t inst)
-{
-    hal_header_t *h = hal_map.hdr;
-    for (hoff_t o = h->list_head[K_STREAM]; o;) {
-        hal_stream_t *s = SHMPTR(o);
-        o = s->o.next;
-        if (s->comp == comp && (!inst || s->inst == inst))
-            hal_obj_delete(&s->o);
-    }
+    return hal_handle_attach(K_STREAM, name);
 }
 
 int hal_stream_write(long long handle, const halsdk_value_t *rec)
