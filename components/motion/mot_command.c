@@ -445,6 +445,20 @@ static int bad_spindle(int n)
 }
 
 /* ---- coordinated moves ---- */
+/* min_limit and max_limit of a SET_*_POSITION_LIMITS command */
+static int bad_limits(const mot_command_t *c)
+{
+    int r;
+
+    if ((r = bad_pos("min_limit", c->min_limit))
+        || (r = bad_pos("max_limit", c->max_limit)))
+        return r;
+    if (c->min_limit > c->max_limit)
+        return reject("min_limit (%g) must not be above max_limit (%g)",
+                      c->min_limit, c->max_limit);
+    return 0;
+}
+
 static int move_args(const mot_command_t *c, tp_move_t *m)
 {
     int r;
@@ -936,13 +950,8 @@ static int run_command(const mot_command_t *c)
         return MOT_ECHO_DONE;
 
     case MOT_CMD_SET_JOINT_POSITION_LIMITS:
-        if ((r = bad_joint(c->joint)) || (r = bad_pos("min_limit",
-                                                      c->min_limit))
-            || (r = bad_pos("max_limit", c->max_limit)))
+        if ((r = bad_joint(c->joint)) || (r = bad_limits(c)))
             return r;
-        if (c->min_limit > c->max_limit)
-            return reject("min_limit (%g) must not be above max_limit (%g)",
-                          c->min_limit, c->max_limit);
         j = &mot->joints[c->joint];
         j->min_pos_limit = c->min_limit;
         j->max_pos_limit = c->max_limit;
@@ -1061,13 +1070,8 @@ static int run_command(const mot_command_t *c)
         return MOT_ECHO_DONE;
 
     case MOT_CMD_SET_AXIS_POSITION_LIMITS:
-        if ((r = bad_axis(c->axis)) || (r = bad_pos("min_limit",
-                                                    c->min_limit))
-            || (r = bad_pos("max_limit", c->max_limit)))
+        if ((r = bad_axis(c->axis)) || (r = bad_limits(c)))
             return r;
-        if (c->min_limit > c->max_limit)
-            return reject("min_limit (%g) must not be above max_limit (%g)",
-                          c->min_limit, c->max_limit);
         a = &mot->axis[c->axis];
         a->min_pos_limit = c->min_limit;
         a->max_pos_limit = c->max_limit;
