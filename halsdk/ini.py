@@ -2,8 +2,9 @@
 
 ``[SECTION]`` headers, ``KEY = VALUE`` lines, ``#`` and ``;`` comment
 lines.  The first occurrence of a key in a section wins and keys are case
-sensitive, as in LinuxCNC.  Each entry remembers its line, so that a
-program that finds a bad value can name the file and line.
+sensitive, as in LinuxCNC (:meth:`IniFile.all` gives every value of a
+repeated key, such as ``[HAL]HALFILE``).  Each entry remembers its line,
+so that a program that finds a bad value can name the file and line.
 """
 
 from __future__ import annotations
@@ -19,6 +20,8 @@ class IniFile:
         self.path = path
         self.values: dict[tuple[str, str], str] = {}
         self.lines: dict[tuple[str, str], int] = {}
+        #: every occurrence (repeated keys such as [HAL]HALFILE), in order
+        self.every: dict[tuple[str, str], list[tuple[str, int]]] = {}
         self.section_lines: dict[str, int] = {}
         section = ""
         with open(path, encoding="utf-8", errors="replace") as f:
@@ -33,12 +36,18 @@ class IniFile:
                 if "=" in line:
                     key, _, value = line.partition("=")
                     where = (section, key.strip())
+                    self.every.setdefault(where, []).append(
+                        (value.strip(), number))
                     if where not in self.values:
                         self.values[where] = value.strip()
                         self.lines[where] = number
 
     def get(self, section: str, key: str) -> Optional[str]:
         return self.values.get((section, key))
+
+    def all(self, section: str, key: str) -> list[str]:
+        """Every value of ``[section]key``, in file order."""
+        return [v for v, _ in self.every.get((section, key), [])]
 
     def line(self, section: str, key: Optional[str] = None) -> int:
         """Line of ``[section]key`` (of the section header when key is

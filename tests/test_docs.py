@@ -24,8 +24,8 @@ DOCS = os.path.join(ROOT, "docs")
 PAGES = ["index", "concepts", "components", "halcmd", "halcompile",
          "python-api",
          "cython-components",
-         "c-components", "motion", "homing", "kinematics", "design",
-         "compat", "benchmarks"]
+         "c-components", "motion", "running", "homing", "kinematics",
+         "design", "compat", "benchmarks"]
 
 
 @pytest.fixture(scope="module")

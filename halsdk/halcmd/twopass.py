@@ -55,21 +55,7 @@ class TwopassError(Exception):
 
 def ini_values(path: str, section: str, key: str) -> list[str]:
     """Every value of ``[section]key`` in an INI file, in order."""
-    values: list[str] = []
-    current = ""
-    with open(path, encoding="utf-8", errors="replace") as f:
-        for raw in f:
-            line = raw.strip()
-            if not line or line[0] in "#;":
-                continue
-            if line.startswith("[") and "]" in line:
-                current = line[1:line.index("]")]
-                continue
-            if current == section and "=" in line:
-                name, _, value = line.partition("=")
-                if name.strip() == key:
-                    values.append(value.strip())
-    return values
+    return IniFile(path).all(section, key)
 
 
 def is_twopass_ini(path: str) -> bool:

@@ -1,0 +1,174 @@
+"""Starting a whole machine from its INI file: ``halsdk run machine.ini``.
+
+What the launcher does, in order:
+
+1. reads the INI file; a missing ``[HAL]HALFILE`` is an error naming the
+   file;
+2. creates the HAL instance (this process is its host) and runs every
+   ``[HAL]HALFILE`` (relative to the INI file's folder; two passes when
+   ``[HAL]TWOPASS`` is set) and ``[HAL]HALCMD`` with ``[SECTION]KEY``
+   substitution from the INI file; the first error (``file:line: ...``)
+   stops the start;
+3. when the HAL files loaded the motion module, configures it from the
+   INI file (:meth:`halsdk.motion.Motion.configure_ini`: [KINS], [TRAJ],
+   [JOINT_n], [AXIS_L]);
+4. starts the realtime threads and runs ``[HAL]POSTGUI_HALFILE``;
+5. runs until SIGINT (Ctrl-C) or SIGTERM, or for ``seconds`` when given;
+6. shuts down: motion disabled, ``[HAL]SHUTDOWN`` run, threads stopped,
+   every module unloaded and the instance removed.
+
+Whatever fails on the way, the machine is left safe: motion is disabled
+before anything else is torn down, and the instance is removed.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import sys
+import threading
+from typing import Any, Optional, TextIO
+
+from halsdk.errors import HalError
+from halsdk.ini import IniFile
+
+
+class LaunchError(HalError):
+    """The machine could not be started (the message says where)."""
+
+
+def _path(ini: IniFile, name: str) -> str:
+    if os.path.isabs(name):
+        return name
+    return os.path.join(os.path.dirname(os.path.abspath(ini.path)), name)
+
+
+class Launcher:
+    """One machine started from an INI file (see the module docstring)."""
+
+    def __init__(self, ini_path: str, out: TextIO = sys.stdout,
+                 err: TextIO = sys.stderr):
+        try:
+            self.ini = IniFile(ini_path)
+        except OSError as e:
+            raise LaunchError(f"{ini_path}: cannot read: {e.strerror}"
+                              ) from None
+        self.out, self.err = out, err
+        self.hal: Any = None
+        self.motion: Any = None
+        self._stop = threading.Event()
+
+    # ------------------------------------------------------------ start
+
+    def start(self, realtime: bool = True) -> None:
+        """Steps 1 to 4; raises LaunchError (after shutting down what was
+        started)."""
+        import halsdk
+        from halsdk.halcmd.commands import Executor
+        halfiles = self.ini.all("HAL", "HALFILE")
+        if not halfiles:
+            raise LaunchError(f"{self.ini.path}: [HAL]HALFILE is missing "
+                              "(the HAL files of the machine)")
+        for name in halfiles:
+            path = _path(self.ini, name.split()[0])
+            if not os.access(path, os.R_OK):
+                raise LaunchError(f"{self.ini.where('HAL', 'HALFILE')}: "
+                                  f"cannot read HAL file '{name}'")
+        self.hal = halsdk.Hal(create=True)
+        try:
+            ex = Executor(self.hal, ini=self.ini.path, register=False)
+            self._load(ex, halfiles)
+            self._configure_motion()
+            if realtime:
+                note = self.hal.start()
+                if note:
+                    print(note, file=self.err)
+            for name in self.ini.all("HAL", "POSTGUI_HALFILE"):
+                self._source(ex, _path(self.ini, name))
+        except BaseException:
+            self.shutdown()
+            raise
+
+    def _load(self, ex: Any, halfiles: list[str]) -> None:
+        if any(self.ini.all("HAL", "TWOPASS")):
+            from halsdk.halcmd import twopass
+            if twopass.run(ex, self.ini.path):
+                raise LaunchError(f"{self.ini.path}: loading the HAL files "
+                                  "(twopass) failed")
+        else:
+            for name in halfiles:
+                self._source(ex, _path(self.ini, name.split()[0]))
+        for command in self.ini.all("HAL", "HALCMD"):
+            if ex.run_lines([command], self.ini.path):
+                raise LaunchError(f"{self.ini.where('HAL', 'HALCMD')}: "
+                                  f"[HAL]HALCMD '{command}' failed")
+
+    def _source(self, ex: Any, path: str) -> None:
+        before = ex.errors
+        ex.run_file(path)
+        if ex.errors != before:
+            raise LaunchError(f"{path}: the HAL file failed (see the "
+                              "message above)")
+
+    def _configure_motion(self) -> None:
+        from halsdk import _core
+        try:
+            _core.shmem_attach("motmod.channel")
+        except HalError:
+            return                      # no motion module: a plain HAL
+        from halsdk.motion import Motion
+        self.motion = Motion.connect(self.hal, timeout=5.0)
+        self.motion.configure_ini(self.ini.path)
+
+    # ------------------------------------------------------------ run
+
+    def wait(self, seconds: Optional[float] = None) -> None:
+        """Step 5: until stop() (SIGINT, SIGTERM) or ``seconds``."""
+        self._stop.wait(seconds)
+
+    def stop(self, *_: Any) -> None:
+        self._stop.set()
+
+    def shutdown(self) -> None:
+        """Step 6 (safe to call more than once)."""
+        hal, self.hal = self.hal, None
+        if hal is None:
+            return
+        try:
+            if self.motion is not None:
+                try:
+                    self.motion.disable()
+                except HalError as e:
+                    print(f"halsdk run: disabling motion: {e}",
+                          file=self.err)
+            for name in self.ini.all("HAL", "SHUTDOWN"):
+                from halsdk.halcmd.commands import Executor
+                ex = Executor(hal, ini=self.ini.path, register=False)
+                ex.run_file(_path(self.ini, name))
+            hal.stop()
+        finally:
+            hal.close()
+
+
+def run(ini_path: str, seconds: Optional[float] = None,
+        realtime: bool = True) -> int:
+    """``halsdk run``: start, run until a signal (or ``seconds``), shut
+    down.  Returns the exit status."""
+    try:
+        machine = Launcher(ini_path)
+        machine.start(realtime=realtime)
+    except HalError as e:
+        print(f"halsdk run: {e}", file=sys.stderr)
+        return 1
+    old = {s: signal.signal(s, machine.stop)
+           for s in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        print(f"halsdk run: {ini_path}: machine running; Ctrl-C stops it",
+              file=machine.out, flush=True)
+        machine.wait(seconds)
+    finally:
+        for s, handler in old.items():
+            signal.signal(s, handler)
+        machine.shutdown()
+    print("halsdk run: stopped", file=machine.out, flush=True)
+    return 0
