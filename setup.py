@@ -166,8 +166,8 @@ if len(set(names)) != len(names):
 
 setup(
     packages=["halsdk", "halsdk.compat", "halsdk.demo", "halsdk.halcmd",
-              "halsdk.components", "halsdk.machine", "halsdk.motion",
-              "halsdk.tools", "halcompile"],
+              "halsdk.components", "halsdk.gcode", "halsdk.machine",
+              "halsdk.motion", "halsdk.tools", "halcompile"],
     package_dir={"halsdk.components": "components"},
     ext_modules=cythonize([core] + components, language_level=3, quiet=True,
                           include_path=["."]),

@@ -23,8 +23,8 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 DOCS = os.path.join(ROOT, "docs")
 PAGES = ["index", "concepts", "components", "halcmd", "halcompile",
          "python-api", "cython-components", "c-components", "motion",
-         "running", "tooltable", "homing", "kinematics", "design", "compat",
-         "benchmarks"]
+         "running", "tooltable", "gcode", "homing", "kinematics", "design",
+         "compat", "benchmarks"]
 
 
 @pytest.fixture(scope="module")

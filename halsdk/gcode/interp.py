@@ -1,0 +1,926 @@
+"""The RS274/NGC interpreter: turns evaluated blocks into canonical commands.
+
+Conventions
+-----------
+* Positions inside the interpreter and in every emitted command are machine
+  coordinates in machine units (``units``); program values are converted
+  from G20/G21 units on entry.  Rotary axes (A, B, C) are never scaled.
+* program position = machine position - G5x offset - G92 offset - TLO.
+* Work offsets #5221.., G92 offsets #5211.., G28/G30 homes #5161/#5181 and
+  tool data #5400.. hold machine units; probe results #5061.. hold the
+  probed point in the active program coordinates and program units.
+* ``tools`` is the interpreter's own copy of the tool table (the reference
+  keeps one in interp and one in IO); M6, M61 and G10 L1/L10/L11 update it
+  the way the developer manual's tool section describes, and the matching
+  canon commands let the machine layer update its copy.
+* Cutter radius compensation (G41/G42 with D = tool number, radius from
+  the tool table) covers straight moves in G17; see interp_comp for what
+  is refused.
+* Not supported (clear error): G76, G84, G87, G88, G10 L2/L20 rotation (R).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+from typing import Any, Optional
+
+from . import canon as C
+from .block import Block, code_key
+from .interp_comp import CompError, CutterComp
+from .modal import AXIS_USERS_GROUP0, ModalState, group_codes
+
+AXES = "xyzabcuvw"
+ROTARY = (3, 4, 5)
+ZERO9: C.Pose = (0.0,) * 9  # type: ignore[assignment]
+#: plane -> (first axis, second axis, normal axis, first/second centre words)
+PLANES = {170: (0, 1, 2, "ij"), 180: (2, 0, 1, "ki"), 190: (1, 2, 0, "jk")}
+COORD_CODES = (540, 550, 560, 570, 580, 590, 591, 592, 593)
+CANNED = (730, 810, 820, 830, 850, 860, 890)
+UNSUPPORTED_MOTION = {760: "G76", 840: "G84", 870: "G87", 880: "G88"}
+
+
+def _pose(values: Any) -> C.Pose:
+    return tuple(float(v) for v in values)  # type: ignore[return-value]
+
+
+class Interpreter:
+    """Executes :class:`~halsdk.gcode.block.Block` objects one at a time."""
+
+    def __init__(self, params: Any, tools: Any, canon: C.Canon, *,
+                 random_toolchanger: bool = False, units: str = "mm") -> None:
+        if units not in ("mm", "inch"):
+            raise ValueError(f"units must be 'mm' or 'inch', not {units!r}")
+        self.params = params
+        self.tools = tools
+        self.canon = canon
+        self.random = random_toolchanger
+        self.machine_metric = units == "mm"
+        self.modal = ModalState(units=210 if self.machine_metric else 200)
+        self.pos = [0.0] * 9
+        self.tlo = [0.0] * 9
+        self.g92 = [0.0] * 9
+        if params.get(5210) == 1:
+            self.g92 = [params.get(5211 + i) for i in range(9)]
+        index = int(params.get(5220)) or 1
+        self.modal.coord_system = COORD_CODES[min(max(index, 1), 9) - 1]
+        self.params.set(5220, index)
+        self.feed = 0.0
+        self.speed = 0.0
+        self.current_tool = -1 if self.random else 0
+        spindle = getattr(tools, "spindle", None)
+        if spindle is not None and spindle.tool >= 0:
+            self.current_tool = int(spindle.tool)
+        self.selected_tool = -1
+        self.selected_pocket = -1
+        self.cycle: dict[str, float] = {}
+        self.line = 0
+        self.ended = False
+        self.line_block: Optional[Block] = None
+        self.comp = CutterComp(canon.emit)
+        params.set_predefined(self._predefined)
+
+    # -- units and coordinates -------------------------------------------
+    @property
+    def program_metric(self) -> bool:
+        return self.modal.units == 210
+
+    def _k(self, axis: int = 0) -> float:
+        """Factor program units -> machine units for ``axis``."""
+        if axis in ROTARY or self.program_metric == self.machine_metric:
+            return 1.0
+        return 25.4 if self.machine_metric else 1 / 25.4
+
+    def _len(self, value: float) -> float:
+        return value * self._k()
+
+    @property
+    def coord_index(self) -> int:
+        return COORD_CODES.index(self.modal.coord_system) + 1
+
+    def _g5x(self, index: int = 0) -> list[float]:
+        base = 5201 + 20 * (index or self.coord_index)
+        return [self.params.get(base + i) for i in range(9)]
+
+    def program_position(self) -> list[float]:
+        """Current position in program coordinates, machine units."""
+        g5x = self._g5x()
+        return [self.pos[i] - g5x[i] - self.g92[i] - self.tlo[i]
+                for i in range(9)]
+
+    def _to_machine(self, prog: list[float]) -> list[float]:
+        g5x = self._g5x()
+        return [prog[i] + g5x[i] + self.g92[i] + self.tlo[i]
+                for i in range(9)]
+
+    def _axis_words(self, block: Block) -> list[str]:
+        return [a for a in AXES if a in block.words]
+
+    def _target(self, block: Block, g53: bool = False) -> list[float]:
+        """The machine end point of a move from the block's axis words."""
+        if g53:
+            end = list(self.pos)
+            for i, a in enumerate(AXES):
+                if a in block.words:
+                    end[i] = block.words[a] * self._k(i) + self.tlo[i]
+            return end
+        prog = self.program_position()
+        incremental = self.modal.distance == 910
+        for i, a in enumerate(AXES):
+            if a in block.words:
+                value = block.words[a] * self._k(i)
+                prog[i] = prog[i] + value if incremental else value
+        return self._to_machine(prog)
+
+    def _emit(self, command: C.Command) -> None:
+        if not self.comp.hold(command):
+            self.canon.emit(command)
+
+    # -- public API ------------------------------------------------------
+    def run(self, program: Any) -> None:
+        """Execute every block of ``program`` until it ends."""
+        for block in program.blocks():
+            self.execute(block)
+            if self.ended:
+                break
+        self.comp.stop()
+
+    def execute(self, block: Block) -> None:
+        """Execute one block in the documented order of execution."""
+        self.line = block.line
+        self.line_block = block
+        gs, ms = group_codes(block)
+        self._check(block, gs, ms)
+        line = block.line
+        if block.message:
+            self._emit(C.Message(block.message, line))
+        if 5 in gs:
+            self.modal.feed_mode = gs[5]
+            self._emit(C.SetFeedMode(
+                "inverse_time" if gs[5] == 930 else "units_per_minute", line))
+        if "f" in block.words and self.modal.feed_mode == 940:
+            f = block.words["f"]
+            if f < 0:
+                raise block.error("negative feed rate", "f")
+            self.feed = self._len(f)
+            self._emit(C.SetFeedRate(self.feed, line))
+        if "s" in block.words:
+            s = block.words["s"]
+            if s < 0:
+                raise block.error("negative spindle speed", "s")
+            self.speed = s
+            self._emit(C.SpindleSpeed(s, line))
+        if "t" in block.words:
+            self._select_tool(block)
+        if 5 in ms:
+            self._hal_io(block, ms[5])
+        if 6 in ms:
+            self._tool_change(block, ms[6])
+        if 7 in ms:
+            self._spindle(ms[7], line)
+        if 8 in ms:
+            code = ms[8]
+            self.modal.mist = code == 70 or (self.modal.mist and code != 90)
+            self.modal.flood = code == 80 or (self.modal.flood and code != 90)
+            self._emit(C.Coolant({70: "mist", 80: "flood", 90: "off"}[code],
+                                 line))
+        if gs.get(0) == 40:
+            p = self._need(block, "p", "G4")
+            if p < 0:
+                raise block.error("negative dwell time", "p")
+            self._emit(C.Dwell(p, line))
+        if 2 in gs:
+            self.modal.plane = gs[2]
+            self._emit(C.SetPlane(gs[2] // 10, line))
+        if 6 in gs:
+            self.modal.units = gs[6]
+        if 7 in gs:
+            self._cutter_comp(block, gs[7])
+        if 8 in gs:
+            self._tool_length(block, gs[8])
+        if 12 in gs:
+            self.modal.coord_system = gs[12]
+            self.params.set(5220, self.coord_index)
+            self._emit(C.SetG5xOffset(self.coord_index, _pose(self._g5x()),
+                                      line))
+        if 13 in gs:
+            self._control(block, gs[13])
+        if 3 in gs:
+            self.modal.distance = gs[3]
+        if 4 in gs:
+            self.modal.arc_distance = gs[4]
+        if 10 in gs:
+            self.modal.retract = gs[10]
+        g0 = gs.get(0)
+        if g0 in (100,):
+            self._g10(block)
+        elif g0 in (280, 300):
+            if self.comp.active:
+                raise block.error("G28/G30 while cutter compensation is on",
+                                  code_key("g", g0 / 10))
+            self._go_home(block, g0)
+        elif g0 in (281, 301):
+            home = self.pos_without_tlo()
+            base = 5161 if g0 == 281 else 5181
+            for i in range(9):
+                self.params.set(base + i, home[i])
+        elif g0 in (920, 921, 922, 923):
+            self._g92(block, g0)
+        self._motion(block, gs)
+        if 4 in ms:
+            self._stop(ms[4], line)
+
+    def pos_without_tlo(self) -> list[float]:
+        return [self.pos[i] - self.tlo[i] for i in range(9)]
+
+    def probe_result(self, position: Any, tripped: bool) -> None:
+        """Report where a G38.x probe move stopped (machine coordinates)."""
+        self.pos = [float(v) for v in position]
+        prog = self.program_position()
+        for i in range(9):
+            self.params.set(5061 + i, prog[i] / self._k(i))
+        self.params.set(5070, 1.0 if tripped else 0.0)
+
+    def input_result(self, value: float) -> None:
+        """Report the value read by M66 (stored in #5399; -1 on timeout)."""
+        self.params.set(5399, float(value))
+
+    # -- checks ----------------------------------------------------------
+    def _need(self, block: Block, letter: str, what: str) -> float:
+        if letter not in block.words:
+            raise block.error(f"{what} needs a {letter.upper()} word",
+                              what.split()[0].lower())
+        return block.words[letter]
+
+    def _check(self, block: Block, gs: dict[int, int],
+               ms: dict[int, int]) -> None:
+        axes = self._axis_words(block)
+        g0 = gs.get(0)
+        user0 = g0 in AXIS_USERS_GROUP0
+        if user0 and gs.get(1, 800) != 800 and axes:
+            raise block.error(
+                f"G{g0 / 10:g} and G{gs[1] / 10:g} both use the axis words",
+                code_key("g", gs[1] / 10))
+        if g0 == 530 and gs.get(1, self.modal.motion) not in (0, 10):
+            raise block.error("G53 needs G0 or G1", "g53")
+        motion = gs.get(1, self.modal.motion)
+        if axes and not user0 and gs.get(8) != 431 and motion == 800:
+            raise block.error(
+                f"{axes[0].upper()} word with no G code to use it", axes[0])
+        for letter in block.words:
+            if letter not in self._word_users(block, gs, ms, motion):
+                raise block.error(f"{letter.upper()} word with no G or M "
+                                  "code to use it", letter)
+
+    def _word_users(self, block: Block, gs: dict[int, int],
+                    ms: dict[int, int], motion: int) -> set[str]:
+        """The letters the codes of a block (and the modal motion) use."""
+        allowed = set(AXES) | set("fstno")
+        g0 = gs.get(0)
+        moving = (motion != 800 and g0 not in AXIS_USERS_GROUP0
+                  and gs.get(8) != 431
+                  and (1 in gs or bool(self._axis_words(block))))
+        if moving and motion in (20, 30):
+            allowed |= set("ijkrp")
+        elif moving and motion == 330:
+            allowed.add("k")
+        elif moving and (motion in CANNED or motion in UNSUPPORTED_MOTION):
+            allowed |= set("rlpq")
+        if g0 == 40:
+            allowed.add("p")
+        elif g0 == 100:
+            allowed |= set("lprijq")
+        if gs.get(8) == 430:
+            allowed.add("h")
+        if gs.get(13) == 640:
+            allowed |= set("pq")
+        if 7 in gs:
+            allowed.add("d")
+        if 5 in ms:
+            allowed |= set("pelq")
+        if ms.get(6) == 610:
+            allowed.add("q")
+        return allowed
+
+    # -- tools -----------------------------------------------------------
+    def _tool_of(self, tool: int) -> Any:
+        """The tool table entry of ``tool`` or None for 'no tool'."""
+        if tool < 0 or (tool == 0 and not self.random):
+            return None
+        pocket = self.tools.pocket_of(tool) if self.tools else None
+        if pocket is None:
+            return None
+        return self.tools.entry(pocket)
+
+    def _update_tool_params(self) -> None:
+        entry = self._tool_of(self.current_tool)
+        p = self.params
+        p.set(5400, max(self.current_tool, 0))
+        offset = entry.offset if entry is not None else ZERO9
+        for i in range(9):
+            p.set(5401 + i, offset[i])
+        p.set(5410, entry.diameter if entry is not None else 0.0)
+        p.set(5411, entry.frontangle if entry is not None else 0.0)
+        p.set(5412, entry.backangle if entry is not None else 0.0)
+        p.set(5413, entry.orientation if entry is not None else 0.0)
+
+    def _tool_number(self, block: Block, letter: str) -> int:
+        value = block.words[letter]
+        if value < 0 or abs(value - round(value)) > 1e-6:
+            raise block.error(f"{letter.upper()} must be a non-negative "
+                              f"integer, not {value:g}", letter)
+        return int(round(value))
+
+    def _pocket_for(self, block: Block, tool: int, letter: str) -> int:
+        if tool == 0 and not self.random:
+            return 0
+        pocket = self.tools.pocket_of(tool) if self.tools else None
+        if pocket is None:
+            raise block.error(f"tool {tool} is not in the tool table", letter)
+        return int(pocket)
+
+    def _select_tool(self, block: Block) -> None:
+        tool = self._tool_number(block, "t")
+        pocket = self._pocket_for(block, tool, "t")
+        self.selected_tool, self.selected_pocket = tool, pocket
+        self._emit(C.SelectTool(tool, pocket, block.line))
+
+    def _tool_change(self, block: Block, code: int) -> None:
+        if code == 60:
+            if self.selected_tool < 0:
+                raise block.error("M6 without a tool selected by a T word",
+                                  "m6")
+            tool, pocket = self.selected_tool, self.selected_pocket
+            self._emit(C.ChangeTool(tool, pocket, block.line))
+            if self.random:
+                if pocket != 0:
+                    old, new = self.tools.entry(0), self.tools.entry(pocket)
+                    self.tools.set_entry(0, replace(new, pocket=0))
+                    self.tools.set_entry(pocket, replace(old, pocket=pocket))
+                self.selected_pocket = 0
+            else:
+                self._load_spindle(pocket)
+        else:
+            if "q" not in block.words:
+                raise block.error("M61 needs a Q word", "m61")
+            tool = self._tool_number(block, "q")
+            pocket = self._pocket_for(block, tool, "q")
+            self._emit(C.ChangeToolNumber(tool, pocket, block.line))
+            if not self.random:
+                self._load_spindle(pocket)
+            elif pocket != 0:
+                old, new = self.tools.entry(0), self.tools.entry(pocket)
+                self.tools.set_entry(0, replace(new, pocket=0))
+                self.tools.set_entry(pocket, replace(old, pocket=pocket))
+        self.current_tool = tool
+        self._update_tool_params()
+
+    def _cutter_comp(self, block: Block, code: int) -> None:
+        key = code_key("g", code / 10)
+        if code == 400:
+            self.comp.stop()
+        else:
+            if self.modal.plane != 170:
+                raise block.error("cutter compensation is only supported in "
+                                  "the XY plane (G17)", key)
+            tool = (self._tool_number(block, "d") if "d" in block.words
+                    else self.current_tool)
+            if "d" in block.words:
+                self._pocket_for(block, tool, "d")
+            entry = self._tool_of(tool)
+            radius = entry.diameter / 2 if entry is not None else 0.0
+            try:
+                self.comp.start(1 if code == 410 else -1, radius)
+            except CompError as e:
+                raise block.error(str(e), key) from None
+        self.modal.cutter_comp = code
+
+    def _load_spindle(self, pocket: int) -> None:
+        """Nonrandom: copy the tool of ``pocket`` to the spindle (0: none)."""
+        if self.tools is None:
+            return
+        if pocket:
+            self.tools.set_entry(0, replace(self.tools.entry(pocket)))
+        else:
+            self.tools.set_entry(0, replace(
+                self.tools.entry(0), tool=0, offset=ZERO9, diameter=0.0,
+                frontangle=0.0, backangle=0.0, orientation=0))
+
+    def _tool_length(self, block: Block, code: int) -> None:
+        if code == 490:
+            offset = [0.0] * 9
+        elif code == 431:
+            offset = [0.0] * 9
+            for i, a in enumerate(AXES):
+                if a in block.words:
+                    offset[i] = block.words[a] * self._k(i)
+        else:
+            tool = (self._tool_number(block, "h") if "h" in block.words
+                    else self.current_tool)
+            if "h" in block.words:
+                self._pocket_for(block, tool, "h")
+            entry = self._tool_of(tool)
+            offset = list(entry.offset) if entry is not None else [0.0] * 9
+        self.modal.tool_length = code
+        self.tlo = [float(v) for v in offset]
+        self._emit(C.UseToolLengthOffset(_pose(self.tlo), block.line))
+
+    def _g10_tool(self, block: Block, level: float) -> None:
+        if "p" not in block.words:
+            raise block.error(f"G10 L{level:g} needs a P word (tool)", "g10")
+        tool = self._tool_number(block, "p")
+        if self.random and tool == self.current_tool:
+            pocket = 0
+        else:
+            pocket = self._pocket_for(block, tool, "p")
+            if pocket == 0 and not self.random:
+                raise block.error("G10 L1 cannot change tool 0", "p")
+        entry = self.tools.entry(pocket)
+        offset = list(entry.offset)
+        for i, a in enumerate(AXES):
+            if a not in block.words:
+                continue
+            value = block.words[a] * self._k(i)
+            if level == 1:
+                offset[i] = value
+            else:
+                base = self._g5x(9) if level == 11 else [
+                    g + h for g, h in zip(self._g5x(), self.g92)]
+                offset[i] = self.pos[i] - base[i] - value
+        changes: dict[str, Any] = {"offset": _pose(offset)}
+        if "r" in block.words:
+            changes["diameter"] = 2 * self._len(block.words["r"])
+        if "i" in block.words:
+            changes["frontangle"] = block.words["i"]
+        if "j" in block.words:
+            changes["backangle"] = block.words["j"]
+        if "q" in block.words:
+            changes["orientation"] = int(round(block.words["q"]))
+        entry = replace(entry, **changes)
+        self.tools.set_entry(pocket, entry)
+        self._emit(self._table_command(pocket, entry, block.line))
+        if tool == self.current_tool and (self.random or tool > 0):
+            if not self.random:
+                self.tools.set_entry(0, replace(entry))
+                self._emit(self._table_command(0, entry, block.line))
+            self._update_tool_params()   # only when the current tool changed
+
+    @staticmethod
+    def _table_command(pocket: int, e: Any, line: int) -> C.SetToolTableEntry:
+        return C.SetToolTableEntry(pocket, e.tool, _pose(e.offset),
+                                   e.diameter, e.frontangle, e.backangle,
+                                   e.orientation, line)
+
+    # -- spindle, coolant, I/O, stops ------------------------------------
+    def _spindle(self, code: int, line: int) -> None:
+        self.modal.spindle = code
+        if code == 50:
+            self._emit(C.SpindleOff(line))
+        else:
+            self._emit(C.SpindleOn(1 if code == 30 else -1, self.speed, line))
+
+    def _index(self, block: Block, letter: str, what: str) -> int:
+        if letter not in block.words:
+            raise block.error(f"{what} needs a {letter.upper()} word",
+                              what.split()[0].lower())
+        value = block.words[letter]
+        if value < 0 or abs(value - round(value)) > 1e-6:
+            raise block.error(f"{letter.upper()} must be a non-negative "
+                              f"integer, not {value:g}", letter)
+        return int(round(value))
+
+    def _hal_io(self, block: Block, code: int) -> None:
+        line = block.line
+        if code in (620, 630, 640, 650):
+            index = self._index(block, "p", f"M{code // 10}")
+            on = code in (620, 640)
+            cls = C.SyncDout if code in (620, 630) else C.DoutNow
+            self._emit(cls(index, on, line))
+        elif code == 660:
+            if ("p" in block.words) == ("e" in block.words):
+                raise block.error("M66 needs exactly one of P and E", "m66")
+            digital = "p" in block.words
+            index = self._index(block, "p" if digital else "e", "M66")
+            mode = int(block.words.get("l", 0))
+            if not 0 <= mode <= 4:
+                raise block.error("M66 L must be 0..4", "l")
+            if mode and not digital:
+                raise block.error("M66 analog inputs need L0", "l")
+            timeout = block.words.get("q", 0.0)
+            if mode and timeout <= 0 and "q" not in block.words:
+                raise block.error("M66 with L1..L4 needs a Q timeout", "m66")
+            self._emit(C.WaitInput(index, digital, mode, timeout, line))
+        else:
+            index = self._index(block, "e", f"M{code // 10}")
+            if "q" not in block.words:
+                raise block.error(f"M{code // 10} needs a Q word",
+                                  code_key("m", code / 10))
+            cls = C.SyncAout if code == 670 else C.AoutNow
+            self._emit(cls(index, block.words["q"], line))
+
+    def _stop(self, code: int, line: int) -> None:
+        if code == 0:
+            self._emit(C.ProgramPause(line))
+        elif code == 10:
+            self._emit(C.OptionalPause(line))
+        else:
+            m = self.modal
+            if m.coord_system != 540:
+                m.coord_system = 540
+                self.params.set(5220, 1)
+                self._emit(C.SetG5xOffset(1, _pose(self._g5x()), line))
+            self.comp.stop()
+            m.plane, m.distance, m.feed_mode = 170, 900, 940
+            m.cutter_comp, m.motion = 400, 10
+            if m.spindle != 50:
+                self._spindle(50, line)
+            if m.mist or m.flood:
+                m.mist = m.flood = False
+                self._emit(C.Coolant("off", line))
+            self._emit(C.ProgramEnd(code == 300, line))
+            self.ended = True
+
+    def _control(self, block: Block, code: int) -> None:
+        if code == 640:
+            p = block.words.get("p")
+            q = block.words.get("q")
+            if q is not None and p is None:
+                raise block.error("G64 Q needs a P word", "q")
+            self._emit(C.SetTermCond(
+                "blend", None if p is None else self._len(p),
+                None if q is None else self._len(q), block.line))
+        else:
+            self._emit(C.SetTermCond(
+                "exact_path" if code == 610 else "exact_stop",
+                line=block.line))
+        self.modal.control = code
+
+    # -- offsets ---------------------------------------------------------
+    def _g10(self, block: Block) -> None:
+        if "l" not in block.words:
+            raise block.error("G10 needs an L word", "g10")
+        level = block.words["l"]
+        if level in (1, 10, 11):
+            self._g10_tool(block, level)
+            return
+        if level not in (2, 20):
+            raise block.error(f"G10 L{level:g} is not supported", "l")
+        if block.words.get("r", 0.0):
+            raise block.error("coordinate system rotation (G10 R) is not "
+                              "supported", "r")
+        p = self._index(block, "p", "G10 L2/L20")
+        if p > 9:
+            raise block.error(f"G10 P{p}: coordinate systems are 0..9", "p")
+        index = p or self.coord_index
+        base = 5201 + 20 * index
+        for i, a in enumerate(AXES):
+            if a in block.words:
+                value = block.words[a] * self._k(i)
+                if level == 20:
+                    value = self.pos[i] - self.tlo[i] - self.g92[i] - value
+                self.params.set(base + i, value)
+        if index == self.coord_index:
+            self._emit(C.SetG5xOffset(index, _pose(self._g5x()), block.line))
+
+    def _g92(self, block: Block, code: int) -> None:
+        if code == 920:
+            if not self._axis_words(block):
+                raise block.error("G92 needs at least one axis word", "g92")
+            g5x = self._g5x()
+            for i, a in enumerate(AXES):
+                if a in block.words:
+                    self.g92[i] = (self.pos[i] - self.tlo[i] - g5x[i]
+                                   - block.words[a] * self._k(i))
+        elif code in (921, 922):
+            self.g92 = [0.0] * 9
+        else:
+            self.g92 = [self.params.get(5211 + i) for i in range(9)]
+        if code != 922:
+            for i in range(9):
+                self.params.set(5211 + i, self.g92[i])
+        self.params.set(5210, 0.0 if code in (921, 922) else 1.0)
+        self._emit(C.SetG92Offset(_pose(self.g92), block.line))
+
+    def _go_home(self, block: Block, code: int) -> None:
+        line = block.line
+        base = 5161 if code == 280 else 5181
+        home = [self.params.get(base + i) + self.tlo[i] for i in range(9)]
+        axes = self._axis_words(block)
+        if axes:
+            middle = self._target(block)
+            self._traverse(middle, line)
+            end = list(self.pos)
+            for i, a in enumerate(AXES):
+                if a in block.words:
+                    end[i] = home[i]
+            self._traverse(end, line)
+        else:
+            self._traverse(home, line)
+
+    # -- motion ----------------------------------------------------------
+    def _traverse(self, end: list[float], line: int) -> None:
+        self._emit(C.StraightTraverse(_pose(end), line))
+        self.pos = list(end)
+
+    def _feed_for(self, block: Block, length: float) -> float:
+        if self.modal.feed_mode == 930:
+            if "f" not in block.words:
+                raise block.error("inverse time feed (G93) needs an F word "
+                                  "on every feed move", "")
+            f = block.words["f"]
+            if f <= 0:
+                raise block.error("inverse time F must be positive", "f")
+            return length * f if length > 0 else f
+        if self.feed <= 0:
+            raise block.error("feed move with zero feed rate", "")
+        return self.feed
+
+    def _straight_feed(self, block: Block, end: list[float]) -> None:
+        length = math.dist(self.pos, end)
+        feed = self._feed_for(block, length)
+        self._emit(C.StraightFeed(_pose(end), feed, block.line))
+        self.pos = list(end)
+
+    def _motion(self, block: Block, gs: dict[int, int]) -> None:
+        explicit = gs.get(1)
+        if explicit is not None:
+            if explicit in UNSUPPORTED_MOTION:
+                raise block.error(f"{UNSUPPORTED_MOTION[explicit]} is not "
+                                  "supported", code_key("g", explicit / 10))
+            self.modal.motion = explicit
+            if explicit == 800:
+                self.cycle = {}
+        has_axes = bool(self._axis_words(block))
+        if gs.get(0) in AXIS_USERS_GROUP0 or gs.get(8) == 431:
+            return
+        motion = self.modal.motion
+        if motion == 800 or not (has_axes or explicit is not None):
+            return
+        line = block.line
+        key = code_key("g", motion / 10)
+        g53 = gs.get(0) == 530
+        if self.comp.active and (motion not in (0, 10) or g53):
+            raise block.error(f"G{'53' if g53 else f'{motion / 10:g}'} "
+                              "while cutter compensation is on is not "
+                              "supported", "g53" if g53 else key)
+        if self.comp.active and has_axes:
+            end = self._target(block)
+            feed = None
+            if motion == 10:
+                feed = self._feed_for(block, math.dist(self.pos, end))
+            try:
+                self.comp.move(self.pos, end, feed, line)
+            except CompError as e:
+                raise block.error(str(e), key) from None
+            self.pos = end
+            return
+        if g53 and self.modal.distance == 910:
+            raise block.error("G53 in incremental mode (G91)", "g53")
+        if motion in (0, 10, 330) or 382 <= motion <= 385:
+            if not has_axes:
+                if motion in (0, 10):
+                    return
+                raise block.error(f"G{motion / 10:g} needs an axis word", key)
+            end = self._target(block, g53)
+            if motion == 0:
+                self._traverse(end, line)
+            elif motion == 10:
+                self._straight_feed(block, end)
+            elif motion == 330:
+                if "k" not in block.words or block.words["k"] <= 0:
+                    raise block.error("G33 needs a positive K word", key)
+                self._emit(C.SyncedFeed(_pose(end), self._len(
+                    block.words["k"]), line))
+                self.pos = end
+            else:
+                self._probe(block, motion, end)
+        elif motion in (20, 30):
+            self._arc(block, motion)
+        else:
+            self._canned(block, motion)
+
+    def _probe(self, block: Block, motion: int, end: list[float]) -> None:
+        key = code_key("g", motion / 10)
+        if self.modal.feed_mode == 930:
+            raise block.error("G38.x cannot be used in inverse time mode",
+                              key)
+        if self.feed <= 0:
+            raise block.error("G38.x with zero feed rate", key)
+        if math.dist(self.pos, end) < 1e-9:
+            raise block.error("G38.x probe move has zero length", key)
+        self._emit(C.Probe(_pose(end), f"{motion / 10:g}", self.feed,
+                           block.line))
+        self.pos = list(end)
+
+    def _arc(self, block: Block, motion: int) -> None:
+        key = code_key("g", motion / 10)
+        a1, a2, _normal, centre_words = PLANES[self.modal.plane]
+        names = AXES[a1].upper() + AXES[a2].upper()
+        in_plane = AXES[a1] in block.words or AXES[a2] in block.words
+        start = self.pos
+        end = self._target(block)
+        s1, s2, e1, e2 = start[a1], start[a2], end[a1], end[a2]
+        k = self._k()
+        tol = 0.005 if self.machine_metric else 0.0005
+        if "r" in block.words:
+            if any(w in block.words for w in centre_words):
+                raise block.error("arc with both R and centre words", "r")
+            if not in_plane:
+                raise block.error(f"{names[0]} and {names[1]} words both "
+                                  "missing for a radius-format arc", key)
+            r = block.words["r"] * k
+            chord = math.hypot(e1 - s1, e2 - s2)
+            if chord < 1e-9:
+                raise block.error("full circle cannot be given with R; use "
+                                  "centre words", "r")
+            if abs(r) < 1e-9:
+                raise block.error("zero radius arc", "r")
+            half = chord / 2
+            if abs(r) < half - tol:
+                raise block.error(f"arc radius {abs(block.words['r']):g} too "
+                                  "small to reach the end point", "r")
+            h = math.sqrt(max(r * r - half * half, 0.0))
+            sign = 1.0 if (motion == 30) != (r < 0) else -1.0
+            m1, m2 = (s1 + e1) / 2, (s2 + e2) / 2
+            c1 = m1 - sign * h * (e2 - s2) / chord
+            c2 = m2 + sign * h * (e1 - s1) / chord
+        else:
+            w1, w2 = centre_words
+            if w1 not in block.words and w2 not in block.words:
+                raise block.error(f"{w1.upper()} and {w2.upper()} words both "
+                                  "missing for a centre-format arc", key)
+            o1, o2 = block.words.get(w1, 0.0) * k, block.words.get(w2, 0.0) * k
+            if self.modal.arc_distance == 901:
+                if w1 not in block.words or w2 not in block.words:
+                    raise block.error(
+                        f"absolute arc centres (G90.1) need both "
+                        f"{w1.upper()} and {w2.upper()}", key)
+                g5x = self._g5x()
+                c1 = (o1 + g5x[a1] + self.g92[a1] + self.tlo[a1]
+                      if w1 in block.words else s1)
+                c2 = (o2 + g5x[a2] + self.g92[a2] + self.tlo[a2]
+                      if w2 in block.words else s2)
+            else:
+                c1, c2 = s1 + o1, s2 + o2
+            r1 = math.hypot(s1 - c1, s2 - c2)
+            r2 = math.hypot(e1 - c1, e2 - c2)
+            if r1 < 1e-9:
+                raise block.error("zero radius arc", key)
+            if abs(r1 - r2) > tol and abs(r1 - r2) > 0.001 * r1:
+                raise block.error(
+                    f"radius to end of arc differs from radius to start "
+                    f"by {abs(r1 - r2) / k:.4g}", key)
+        turns = 1
+        if "p" in block.words:
+            p = block.words["p"]
+            if p < 1 or abs(p - round(p)) > 1e-6:
+                raise block.error("arc P (turns) must be a positive integer",
+                                  "p")
+            turns = int(round(p))
+        turn = turns if motion == 30 else -turns
+        length = self._arc_length(start, end, (c1, c2), a1, a2, turn)
+        feed = self._feed_for(block, length)
+        self._emit(C.ArcFeed(_pose(end), (c1, c2), self.modal.plane // 10,
+                             turn, feed, block.line))
+        self.pos = list(end)
+
+    @staticmethod
+    def _arc_length(start: list[float], end: list[float],
+                    c: tuple[float, float], a1: int, a2: int,
+                    turn: int) -> float:
+        r = math.hypot(start[a1] - c[0], start[a2] - c[1])
+        t0 = math.atan2(start[a2] - c[1], start[a1] - c[0])
+        t1 = math.atan2(end[a2] - c[1], end[a1] - c[0])
+        sweep = t1 - t0
+        if turn > 0:
+            while sweep <= 1e-12:
+                sweep += 2 * math.pi
+        else:
+            while sweep >= -1e-12:
+                sweep -= 2 * math.pi
+        sweep = abs(sweep) + 2 * math.pi * (abs(turn) - 1)
+        planar = r * sweep
+        rest = [end[i] - start[i] for i in range(9) if i not in (a1, a2)]
+        return math.hypot(planar, math.hypot(*rest))
+
+    # -- canned cycles ---------------------------------------------------
+    def _canned(self, block: Block, motion: int) -> None:
+        key = code_key("g", motion / 10)
+        line = block.line
+        a1, a2, d, _ = PLANES[self.modal.plane]
+        dl = AXES[d]
+        for letter in ("r", dl, "p", "q"):
+            if letter in block.words:
+                self.cycle[letter] = block.words[letter]
+        for letter in ("r", dl):
+            if letter not in self.cycle:
+                raise block.error(f"canned cycle G{motion / 10:g} needs an "
+                                  f"{letter.upper()} word", key)
+        if motion in (730, 830) and self.cycle.get("q", 0) <= 0:
+            raise block.error(f"G{motion / 10:g} needs a positive Q word",
+                              key)
+        repeats = int(block.words.get("l", 1))
+        if repeats < 0:
+            raise block.error("L must not be negative", "l")
+        k = self._k()
+        prog = self.program_position()
+        old = prog[d]
+        incremental = self.modal.distance == 910
+        r = self.cycle["r"] * k + (old if incremental else 0.0)
+        bottom = self.cycle[dl] * k + (r if incremental else 0.0)
+        if bottom > r:
+            raise block.error("canned cycle R plane is below the bottom "
+                              f"({dl.upper()})", "r")
+        clear = max(old, r) if self.modal.retract == 980 else r
+        if self.feed <= 0 or self.modal.feed_mode == 930:
+            raise block.error("canned cycle needs a feed rate in G94 mode",
+                              key)
+        if old < r:
+            prog[d] = r
+            self._traverse(self._to_machine(prog), line)
+        for _ in range(repeats):
+            for axis in (a1, a2):
+                letter = AXES[axis]
+                if letter in block.words:
+                    value = block.words[letter] * self._k(axis)
+                    prog[axis] = prog[axis] + value if incremental else value
+            self._traverse(self._to_machine(prog), line)
+            prog[d] = r
+            self._traverse(self._to_machine(prog), line)
+            self._cycle_body(motion, prog, d, r, bottom, line)
+            prog[d] = clear
+            self._traverse(self._to_machine(prog), line)
+
+    def _cycle_body(self, motion: int, prog: list[float], d: int, r: float,
+                    bottom: float, line: int) -> None:
+        def rapid(z: float) -> None:
+            prog[d] = z
+            self._traverse(self._to_machine(prog), line)
+
+        def feed(z: float) -> None:
+            prog[d] = z
+            end = self._to_machine(prog)
+            self._emit(C.StraightFeed(_pose(end), self.feed, line))
+            self.pos = end
+
+        if motion in (730, 830):
+            q = self.cycle["q"] * self._k()
+            delta = 0.254 if self.machine_metric else 0.01
+            depth = r
+            while depth > bottom:
+                target = max(depth - q, bottom)
+                feed(target)
+                depth = target
+                if depth <= bottom:
+                    break
+                if motion == 830:
+                    rapid(r)
+                    rapid(depth + delta)
+                else:
+                    rapid(depth + delta)
+            return
+        feed(bottom)
+        if motion in (820, 890) and self.cycle.get("p", 0) > 0:
+            self._emit(C.Dwell(self.cycle["p"], line))
+        if motion in (850, 890):
+            feed(r)
+        elif motion == 860:
+            self._emit(C.SpindleOff(line))
+            rapid(r)
+            if self.modal.spindle != 50:
+                self._emit(C.SpindleOn(1 if self.modal.spindle == 30 else -1,
+                                       self.speed, line))
+
+    # -- predefined named parameters -------------------------------------
+    def _predefined(self, name: str) -> Optional[float]:
+        name = name.strip("<>").lower()
+        if len(name) == 2 and name[1] in AXES:
+            i = AXES.index(name[1])
+            return self.program_position()[i] / self._k(i)
+        m = self.modal
+        table: dict[str, float] = {
+            "_feed": self.feed / self._k(),
+            "_rpm": self.speed,
+            "_metric": float(self.program_metric),
+            "_imperial": float(not self.program_metric),
+            "_absolute": float(m.distance == 900),
+            "_incremental": float(m.distance == 910),
+            "_inverse_time": float(m.feed_mode == 930),
+            "_units_per_minute": float(m.feed_mode == 940),
+            "_coord_system": float(m.coord_system),
+            "_motion_mode": float(m.motion),
+            "_plane": float(m.plane),
+            "_ccomp": float(m.cutter_comp),
+            "_tool_offset": float(m.tool_length != 490),
+            "_retract_r_plane": float(m.retract == 990),
+            "_retract_old_z": float(m.retract == 980),
+            "_spindle_on": float(m.spindle != 50),
+            "_spindle_cw": float(m.spindle == 30),
+            "_mist": float(m.mist),
+            "_flood": float(m.flood),
+            "_current_tool": float(self.current_tool),
+            "_selected_tool": float(self.selected_tool),
+            "_selected_pocket": float(self.selected_pocket),
+            "_line": float(self.line),
+        }
+        return table.get(name)

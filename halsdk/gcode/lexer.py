@@ -1,0 +1,423 @@
+"""Reading one line of G-code into words, assignments, comments and o-words.
+
+Values stay expression trees (see :mod:`.expr`); they are evaluated when
+the program reaches the line.  Whitespace outside comments is dropped and
+letters are lower-cased, but every character keeps its source column so
+errors point at the right place.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Optional
+
+from .errors import GCodeError
+from .expr import (
+    BINARY,
+    FUNCTIONS,
+    Atan,
+    Binary,
+    Exists,
+    Expr,
+    Function,
+    Negate,
+    Number,
+    ParamRef,
+)
+
+#: Letters that may start a word (o-words are handled apart).
+WORD_LETTERS = frozenset("abcdefghijklmnpqrstuvwxyz")
+
+#: The o-word keywords.
+O_KEYWORDS = ("sub", "endsub", "return", "call", "if", "elseif", "else",
+              "endif", "while", "endwhile", "do", "repeat", "endrepeat",
+              "break", "continue")
+
+
+@dataclass
+class Word:
+    letter: str
+    value: Expr
+    column: int
+
+
+@dataclass
+class Assignment:
+    target: ParamRef
+    value: Expr
+    column: int
+
+
+@dataclass
+class OWord:
+    """``o<name> keyword [args]``; ``name`` is a string (``'100'`` or a
+    lower-case name) or an expression for ``o[#1] call``."""
+
+    name: object
+    keyword: str
+    args: list[Expr]
+    column: int
+
+
+@dataclass
+class Comment:
+    """A comment; ``kind`` is 'msg', 'debug', 'print' or '' (plain)."""
+
+    text: str
+    kind: str
+    column: int
+
+
+@dataclass
+class Line:
+    """One source line as read, not yet evaluated."""
+
+    file: str
+    number: int
+    text: str
+    block_delete: bool = False
+    line_number: Optional[float] = None
+    words: list[Word] = field(default_factory=list)
+    assignments: list[Assignment] = field(default_factory=list)
+    comments: list[Comment] = field(default_factory=list)
+    oword: Optional[OWord] = None
+    percent: bool = False
+
+    @property
+    def empty(self) -> bool:
+        return not (self.words or self.assignments or self.oword
+                    or self.comments)
+
+
+class _Reader:
+    """A cursor over the significant characters of a line."""
+
+    def __init__(self, chars: list[tuple[str, int]], file: str, line: int,
+                 end_column: int) -> None:
+        self.chars = chars
+        self.pos = 0
+        self.file = file
+        self.line = line
+        self.end_column = end_column
+
+    def peek(self, offset: int = 0) -> str:
+        index = self.pos + offset
+        return self.chars[index][0] if index < len(self.chars) else ""
+
+    def column(self) -> int:
+        if self.pos < len(self.chars):
+            return self.chars[self.pos][1]
+        return self.end_column
+
+    def take(self) -> str:
+        char = self.peek()
+        self.pos += 1
+        return char
+
+    def at_end(self) -> bool:
+        return self.pos >= len(self.chars)
+
+    def error(self, message: str, column: Optional[int] = None) -> GCodeError:
+        return GCodeError(message, self.file, self.line,
+                          self.column() if column is None else column)
+
+    def startswith(self, text: str) -> bool:
+        return all(self.peek(i) == c for i, c in enumerate(text))
+
+
+def _strip(text: str, file: str, lineno: int
+           ) -> tuple[list[tuple[str, int]], list[Comment]]:
+    """Split a line into significant characters (with columns) and
+    comments."""
+    chars: list[tuple[str, int]] = []
+    comments: list[Comment] = []
+    i = 0
+    while i < len(text):
+        char = text[i]
+        if char == "(":
+            end = text.find(")", i + 1)
+            if end < 0:
+                raise GCodeError("unclosed comment: '(' without ')'",
+                                 file, lineno, i + 1)
+            nested = text.find("(", i + 1, end)
+            if nested >= 0:
+                raise GCodeError("nested comment: '(' inside a comment",
+                                 file, lineno, nested + 1)
+            comments.append(_comment(text[i + 1:end], i + 1))
+            i = end + 1
+            continue
+        if char == ";":
+            comments.append(Comment(text[i + 1:].strip(), "", i + 1))
+            break
+        if not char.isspace():
+            chars.append((char.lower(), i + 1))
+        i += 1
+    return chars, comments
+
+
+def _comment(body: str, column: int) -> Comment:
+    head, comma, rest = body.partition(",")
+    kind = "".join(head.split()).lower()
+    if comma and kind in ("msg", "debug", "print"):
+        return Comment(rest.strip() if kind == "msg" else rest, kind, column)
+    return Comment(body, "", column)
+
+
+def parse_line(text: str, file: str = "<string>", lineno: int = 1) -> Line:
+    """Read one line of G-code; raises :class:`GCodeError` with its column."""
+    chars, comments = _strip(text.rstrip("\r\n"), file, lineno)
+    line = Line(file, lineno, text.rstrip("\r\n"), comments=comments)
+    reader = _Reader(chars, file, lineno, len(text.rstrip("\r\n")) + 1)
+    if reader.peek() == "%":
+        reader.take()
+        if not reader.at_end():
+            raise reader.error("nothing may follow '%' on its line")
+        line.percent = True
+        return line
+    if reader.peek() == "/":
+        reader.take()
+        line.block_delete = True
+    if reader.peek() == "n":
+        reader.take()
+        line.line_number = _unsigned_number(reader)
+    if reader.peek() == "o":
+        line.oword = _oword(reader)
+        if not reader.at_end():
+            raise reader.error(f"unexpected '{reader.peek()}' after o-word")
+        return line
+    seen: dict[str, int] = {}
+    while not reader.at_end():
+        column = reader.column()
+        char = reader.peek()
+        if char == "#":
+            target = _parameter(reader)
+            if reader.peek() != "=":
+                raise reader.error("expected '=' after a parameter at the "
+                                   "start of a word")
+            reader.take()
+            line.assignments.append(
+                Assignment(target, _real_value(reader), column))
+            continue
+        if char not in WORD_LETTERS:
+            if char == "o":
+                raise reader.error("an o-word must start its line")
+            if char.isalpha():
+                raise reader.error(f"unknown word letter '{char.upper()}'")
+            raise reader.error(f"unexpected character '{char}'")
+        reader.take()
+        if char == "n":
+            raise reader.error("line number N must start the line", column)
+        if char not in "gm":
+            if char in seen:
+                raise reader.error(
+                    f"two {char.upper()} words on one line "
+                    f"(first at column {seen[char]})", column)
+            seen[char] = column
+        line.words.append(Word(char, _real_value(reader), column))
+    return line
+
+
+def _unsigned_number(reader: _Reader) -> float:
+    start = reader.column()
+    digits = ""
+    while reader.peek().isdigit() or reader.peek() == ".":
+        digits += reader.take()
+    try:
+        return float(digits)
+    except ValueError:
+        raise reader.error("bad number", start) from None
+
+
+def _number(reader: _Reader) -> Number:
+    """A decimal number with optional sign: ``-1.5``, ``+.25``, ``3``."""
+    start = reader.column()
+    text = ""
+    if reader.peek() and reader.peek() in "+-":
+        text += reader.take()
+    seen_dot = False
+    digits = 0
+    while reader.peek().isdigit() or reader.peek() == ".":
+        char = reader.take()
+        if char == ".":
+            if seen_dot:
+                raise reader.error("bad number: a second decimal point",
+                                   reader.chars[reader.pos - 1][1])
+            seen_dot = True
+        else:
+            digits += 1
+        text += char
+    if not digits:
+        found = reader.peek()
+        what = f"'{found}'" if found else "end of line"
+        raise reader.error(f"bad number: expected a number, found {what}",
+                           start)
+    return Number(float(text), start)
+
+
+def _starts_operand(char: str) -> bool:
+    """True if ``char`` starts a bracket, parameter or function."""
+    return char in ("[", "#") or char.isalpha()
+
+
+def _real_value(reader: _Reader) -> Expr:
+    """A word value: number, ``[expr]``, ``#param``, a function call or a
+    signed one of these."""
+    char = reader.peek()
+    column = reader.column()
+    if char == "[":
+        return _bracketed(reader)
+    if char == "#":
+        return _parameter(reader)
+    if char and char in "+-" and _starts_operand(reader.peek(1)):
+        # a sign before [expr], #param or a function
+        reader.take()
+        operand = _real_value(reader)
+        return Negate(operand, column) if char == "-" else operand
+    if char.isalpha():
+        return _function(reader)
+    return _number(reader)
+
+
+def _bracketed(reader: _Reader) -> Expr:
+    open_column = reader.column()
+    reader.take()
+    value = _expression(reader, 1)
+    if reader.peek() != "]":
+        if reader.at_end():
+            raise reader.error("unclosed bracket: '[' without ']'",
+                               open_column)
+        raise reader.error(f"expected an operator or ']', found "
+                           f"'{reader.peek()}'")
+    reader.take()
+    return value
+
+
+def _operator(reader: _Reader) -> Optional[str]:
+    if reader.startswith("**"):
+        return "**"
+    if reader.peek() in ("*", "/", "+", "-"):
+        return reader.peek()
+    for name in ("mod", "eq", "ne", "gt", "ge", "lt", "le", "and", "or",
+                 "xor"):
+        if reader.startswith(name):
+            return name
+    return None
+
+
+def _expression(reader: _Reader, min_precedence: int) -> Expr:
+    """Precedence climbing over :data:`BINARY`; equal precedence is
+    left-associative."""
+    left = _real_value(reader)
+    while True:
+        op = _operator(reader)
+        if op is None or BINARY[op][0] < min_precedence:
+            return left
+        column = reader.column()
+        reader.pos += len(op)
+        right = _expression(reader, BINARY[op][0] + 1)
+        left = Binary(op, left, right, column)
+
+
+def _function(reader: _Reader) -> Expr:
+    column = reader.column()
+    name = ""
+    while reader.peek().isalpha():
+        name += reader.take()
+    if name == "atan":
+        if reader.peek() != "[":
+            raise reader.error("ATAN needs [y]/[x]")
+        y = _bracketed(reader)
+        if reader.peek() != "/":
+            raise reader.error("ATAN needs '/[x]' after its first argument")
+        reader.take()
+        if reader.peek() != "[":
+            raise reader.error("ATAN needs [x] after '/'")
+        return Atan(y, _bracketed(reader), column)
+    if name == "exists":
+        if reader.peek() != "[":
+            raise reader.error("EXISTS needs [#<name>]")
+        open_column = reader.column()
+        reader.take()
+        if not (reader.peek() == "#" and reader.peek(1) == "<"):
+            raise reader.error("EXISTS takes one named parameter #<name>")
+        reader.take()
+        target = _name(reader)
+        if reader.peek() != "]":
+            if reader.at_end():
+                raise reader.error("unclosed bracket: '[' without ']'",
+                                   open_column)
+            raise reader.error("EXISTS takes one named parameter #<name>")
+        reader.take()
+        return Exists(target, column)
+    if name not in FUNCTIONS:
+        raise reader.error(f"unknown function '{name.upper()}'", column)
+    if reader.peek() != "[":
+        raise reader.error(f"{name.upper()} needs an argument in [ ]")
+    return Function(name, _bracketed(reader), column)
+
+
+def _name(reader: _Reader) -> str:
+    """``<name>`` (the cursor is on '<'): lower case, no spaces."""
+    open_column = reader.column()
+    reader.take()
+    name = ""
+    while not reader.at_end() and reader.peek() != ">":
+        name += reader.take()
+    if reader.at_end():
+        raise reader.error("unclosed parameter name: '<' without '>'",
+                           open_column)
+    reader.take()
+    if not name:
+        raise reader.error("empty parameter name", open_column)
+    return name
+
+
+def _parameter(reader: _Reader) -> ParamRef:
+    """``#n``, ``#<name>``, ``#[expr]``, ``##n`` (cursor on '#')."""
+    column = reader.column()
+    reader.take()
+    char = reader.peek()
+    if char == "<":
+        return ParamRef(_name(reader), column)
+    if char == "#":
+        return ParamRef(_parameter(reader), column)
+    if char == "[":
+        return ParamRef(_bracketed(reader), column)
+    if char.isdigit():
+        return ParamRef(_number(reader), column)
+    raise reader.error("expected a parameter number, #, [ or <name> "
+                       "after '#'")
+
+
+def _oword(reader: _Reader) -> OWord:
+    column = reader.column()
+    reader.take()
+    name: object
+    if reader.peek() == "<":
+        name = _name(reader)
+    elif reader.peek() == "[" or reader.peek() == "#":
+        name = _real_value(reader)
+    elif reader.peek().isdigit():
+        number = _unsigned_number(reader)
+        name = f"{number:g}"
+    else:
+        raise reader.error("expected an o-word number or <name> after 'O'")
+    keyword_column = reader.column()
+    keyword = ""
+    while reader.peek().isalpha():
+        keyword += reader.take()
+    if keyword not in O_KEYWORDS:
+        text = f"'{keyword}'" if keyword else "nothing"
+        raise reader.error(f"unknown o-word keyword {text}", keyword_column)
+    args: list[Expr] = []
+    if keyword in ("if", "elseif", "while", "repeat", "return", "endsub",
+                   "call"):
+        while reader.peek() == "[":
+            args.append(_bracketed(reader))
+    if keyword in ("if", "elseif", "while", "repeat") and len(args) != 1:
+        raise reader.error(f"O {keyword} needs one [condition]"
+                           if keyword != "repeat" else
+                           "O repeat needs one [count]")
+    if keyword in ("return", "endsub") and len(args) > 1:
+        raise reader.error(f"O {keyword} takes at most one [value]")
+    return OWord(name, keyword, args, column)

@@ -1,0 +1,108 @@
+"""Modal groups of G and M codes and the per-block group checks."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from .block import code_key
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .block import Block
+
+
+def _key(value: float) -> int:
+    """G/M numbers as integers in tenths: 38.2 -> 382, 1 -> 10."""
+    return int(round(value * 10))
+
+
+# group number -> codes (tenths). Group 0 is non-modal.
+G_GROUPS: dict[int, tuple[int, ...]] = {
+    0: (40, 100, 280, 281, 300, 301, 530, 920, 921, 922, 923),
+    1: (0, 10, 20, 30, 330, 382, 383, 384, 385, 730, 760,
+        800, 810, 820, 830, 840, 850, 860, 870, 880, 890),
+    2: (170, 180, 190),
+    3: (900, 910),
+    4: (901, 911),
+    5: (930, 940),
+    6: (200, 210),
+    7: (400, 410, 420),
+    8: (430, 431, 490),
+    10: (980, 990),
+    12: (540, 550, 560, 570, 580, 590, 591, 592, 593),
+    13: (610, 611, 640),
+}
+M_GROUPS: dict[int, tuple[int, ...]] = {
+    4: (0, 10, 20, 300),
+    5: (620, 630, 640, 650, 660, 670, 680),
+    6: (60, 610),
+    7: (30, 40, 50),
+    8: (70, 80, 90),
+}
+_G_OF = {code: group for group, codes in G_GROUPS.items() for code in codes}
+_M_OF = {code: group for group, codes in M_GROUPS.items() for code in codes}
+
+#: G codes that consume the axis words of a block (besides motion).
+AXIS_USERS_GROUP0 = (100, 280, 300, 920)
+
+
+def group_codes(block: Block) -> tuple[dict[int, int], dict[int, int]]:
+    """Map group -> code (tenths) for the G and M codes of ``block``.
+
+    Raises the block's error for an unknown code or two codes of one modal
+    group, pointing at the second one.
+    """
+    gs: dict[int, int] = {}
+    for value in block.g:
+        code = _key(value)
+        name = code_key("g", value)
+        if code not in _G_OF:
+            raise block.error(f"unknown or unsupported G code G{name[1:]}",
+                              name)
+        group = _G_OF[code]
+        if group in gs:
+            raise block.error(
+                f"two G codes of modal group {group} in one block "
+                f"(G{gs[group] / 10:g} and G{name[1:]})", name)
+        gs[group] = code
+    ms: dict[int, int] = {}
+    for value in block.m:
+        code = _key(value)
+        name = code_key("m", value)
+        if code not in _M_OF:
+            raise block.error(f"unknown or unsupported M code M{name[1:]}",
+                              name)
+        group = _M_OF[code]
+        if group in ms:
+            raise block.error(
+                f"two M codes of modal group {group} in one block "
+                f"(M{ms[group] / 10:g} and M{name[1:]})", name)
+        ms[group] = code
+    return gs, ms
+
+
+@dataclass
+class ModalState:
+    """The modal settings in effect (codes in tenths, e.g. motion 10 = G1)."""
+
+    motion: int = 10            # G1 after start-up as after M2
+    plane: int = 170
+    distance: int = 900
+    arc_distance: int = 911
+    feed_mode: int = 940
+    units: int = 210
+    cutter_comp: int = 400
+    tool_length: int = 490
+    retract: int = 980
+    coord_system: int = 540
+    control: int = 640
+    spindle: int = 50           # M5
+    mist: bool = False
+    flood: bool = False
+
+    def gcodes(self) -> tuple[float, ...]:
+        """The active G codes as numbers (like the reference status)."""
+        return tuple(c / 10 for c in (
+            self.motion, self.plane, self.distance, self.arc_distance,
+            self.feed_mode, self.units, self.cutter_comp, self.tool_length,
+            self.retract, self.coord_system, self.control))
