@@ -21,8 +21,9 @@ from halsdk.build import build_component
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 DOCS = os.path.join(ROOT, "docs")
-PAGES = ["index", "concepts", "components", "halcmd", "halcompile",
-         "python-api", "cython-components", "c-components", "motion",
+PAGES = ["index", "concepts", "tutorial", "components", "halcmd",
+         "halcompile", "python-api", "cython-components", "c-components",
+         "motion",
          "running", "tooltable", "gcode", "homing", "kinematics", "design",
          "compat", "benchmarks"]
 
