@@ -279,9 +279,20 @@ class Motion:
 
     # ------------------------------------------------------------ waiting
 
-    def _stepping(self) -> bool:
+    @property
+    def stepping(self) -> bool:
+        """True when waits step the servo thread themselves (the client
+        has the Hal and its threads do not run in real time)."""
         return (self._hal is not None and
                 not _core.info()["threads_running"])
+
+    def moves_done(self, status: Optional[Status] = None) -> bool:
+        """Every queued move was taken and has run, and nothing moves
+        (what wait_done waits for); without waiting."""
+        st = self.status() if status is None else status
+        return (st.queue_taken == self._ch.queue_state()[0]
+                and st.queue_depth == 0 and st.in_position
+                and not st.homing)
 
     def _wait(self, cond: Callable[[], Any], timeout: Optional[float],
               what: str) -> Any:
@@ -292,7 +303,7 @@ class Motion:
             r = cond()
             if r:
                 return r
-            if self._stepping():
+            if self.stepping:
                 period = self._servo_period()
                 for _ in range(max(1, math.ceil(timeout / period))):
                     self._hal.step(1, thread=self.thread)
