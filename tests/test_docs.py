@@ -23,9 +23,8 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 DOCS = os.path.join(ROOT, "docs")
 PAGES = ["index", "concepts", "tutorial", "components", "halcmd",
          "halcompile", "python-api", "cython-components", "c-components",
-         "motion",
-         "running", "tooltable", "gcode", "homing", "kinematics", "design",
-         "compat", "benchmarks"]
+         "motion", "running", "machine", "tooltable", "gcode", "homing",
+         "kinematics", "design", "compat", "benchmarks"]
 
 
 @pytest.fixture(scope="module")
