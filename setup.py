@@ -167,8 +167,11 @@ if len(set(names)) != len(names):
 setup(
     packages=["halsdk", "halsdk.compat", "halsdk.demo", "halsdk.halcmd",
               "halsdk.components", "halsdk.gcode", "halsdk.machine",
-              "halsdk.motion", "halsdk.tools", "halcompile"],
-    package_dir={"halsdk.components": "components"},
+              "halsdk.motion", "halsdk.tools", "halcompile",
+              "halsdk.demo.mill"],
+    # the demo's machine is examples/mill, installed as package data
+    package_dir={"halsdk.components": "components",
+                 "halsdk.demo.mill": "examples/mill"},
     ext_modules=cythonize([core] + components, language_level=3, quiet=True,
                           include_path=["."]),
 )

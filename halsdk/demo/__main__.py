@@ -1,4 +1,4 @@
-"""``python -m halsdk.demo``"""
+"""``python -m halsdk.demo``: the same as ``halsdk-demo``."""
 
 import sys
 

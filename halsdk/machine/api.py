@@ -170,12 +170,16 @@ class Machine:
 
     # -- manual ----------------------------------------------------------
 
-    def home(self, joint: int = -1, wait: bool = True) -> None:
-        """``command.home``: home ``joint`` (-1: all, in sequence)."""
+    def home(self, joint: int = -1, wait: bool = True,
+             timeout: Optional[float] = 120.0) -> None:
+        """``command.home``: home ``joint`` (-1: all, in sequence); with
+        ``wait``, until homed (``timeout`` seconds, simulated when
+        stepping: a search across a long axis takes a while)."""
         self.task.require_mode(TaskMode.MANUAL, "home")
         self.motion.home(joint)
         if wait:
-            self.motion.wait_homed(None if joint < 0 else [joint])
+            self.motion.wait_homed(None if joint < 0 else [joint],
+                                   timeout=timeout)
 
     def jog(self, joint: int, vel: float, distance: Optional[float] = None,
             *, wait: bool = True) -> None:
