@@ -400,9 +400,62 @@ def test_g83_and_g73_pecks():
 
 
 def test_canned_errors():
-    assert "needs an R" in str(err("F1 G81 Z-1\n"))
+    assert "needs the word R" in str(err("F1 G81 Z-1\n"))
     assert "below the bottom" in str(err("F1 G81 R-2 Z-1\n"))
-    assert "not supported" in str(err("F1 G84 R1 Z-1\n"))
+    assert "not supported" in str(err("F1 G87 R1 Z-1\n"))
+
+
+def test_g84_tap_sequence():
+    out = drill("S200 M3 F250\nG0 Z5\nG84 X1 R1 Z-2 P0.5\n")
+    assert out[3:] == [
+        ("T", (1, 0, 5)), ("T", (1, 0, 1)), ("F", (1, 0, -2)),
+        ("SpindleOff", None), ("SpindleOn", None), ("Dwell", None),
+        ("F", (1, 0, 1)), ("SpindleOff", None), ("SpindleOn", None),
+        ("T", (1, 0, 5))]
+    _, rec = run("S200 M3 F250\nG0 Z5\nG84 X1 R1 Z-2 P0.5\n")
+    ons = rec.of_type(C.SpindleOn)
+    assert [c.direction for c in ons] == [1, -1, 1]
+    assert all(c.rpm == 200 for c in ons)
+    assert rec.of_type(C.Dwell)[0].seconds == 0.5
+    assert all(c.feed == 250 for c in rec.of_type(C.StraightFeed))
+    out = drill("S200 M3 F250\nG0 Z5\nG84 R1 Z-2\n")
+    assert "Dwell" not in [k for k, _ in out]
+
+
+def test_g88_sequence():
+    out = drill("S100 M4 F10\nG0 Z5\nG88 X2 R1 Z-1 P1\n")
+    assert out[3:] == [
+        ("T", (2, 0, 5)), ("T", (2, 0, 1)), ("F", (2, 0, -1)),
+        ("Dwell", None), ("SpindleOff", None), ("ProgramPause", None),
+        ("SpindleOn", None), ("T", (2, 0, 5))]
+    _, rec = run("S100 M4 F10\nG0 Z5\nG88 X2 R1 Z-1 P1\n")
+    assert rec.of_type(C.SpindleOn)[-1].direction == -1
+
+
+def test_g84_g88_retract_modes_and_repeats():
+    out = drill("S100 M3 F10\nG0 Z10\nG99 G84 X1 R2 Z-3\n")
+    assert out[-1] == ("T", (1, 0, 2))
+    out = drill("S100 M3 F10\nG0 Z10\nG98 G88 X1 R2 Z-3\n")
+    assert out[-1] == ("T", (1, 0, 10))
+    out = drill("S100 M3 F10\nG0 Z5\nG91 G84 X2 R-3 Z-4 L2\n")
+    assert [p for k, p in out if k == "F"] == [
+        (2, 0, -2), (2, 0, 2), (4, 0, -2), (4, 0, 2)]
+    out = drill("S100 M3 F10\nG0 Z5\nG91 G88 Y1 R-3 Z-4 L2\n")
+    assert [p for k, p in out if k == "F"] == [(0, 1, -2), (0, 2, -2)]
+    assert [k for k, _ in out].count("ProgramPause") == 2
+
+
+def test_g84_g88_errors():
+    e = err("S100 M3 F10\nG84 Z-1\n")
+    assert (e.line, e.column) == (2, 1) and "needs the word R" in str(e)
+    e = err("S100 M3 F10\nG88 R1\n")
+    assert (e.line, e.column) == (2, 1) and "needs the word Z" in str(e)
+    e = err("S100 M4 F10\n G84 R1 Z-1\n")
+    assert (e.line, e.column) == (2, 2) and "clockwise" in str(e)
+    e = err("F10\nG88 R1 Z-1\n")
+    assert e.line == 2 and "spindle turning" in str(e)
+    e = err("S100 M3\nG84 R1 Z-1\n")
+    assert e.line == 2 and "feed rate" in str(e)
 
 
 # -- spindle, coolant, I/O, program end -------------------------------------

@@ -16,7 +16,12 @@ Conventions
 * Cutter radius compensation (G41/G42 with D = tool number, radius from
   the tool table) covers straight moves in G17; see interp_comp for what
   is refused.
-* Not supported (clear error): G76, G84, G87, G88, G10 L2/L20 rotation (R).
+* G84 is the floating-chuck tap of the reference manual: feed in, spindle
+  reversed for a feed out at the same rate, no spindle synchronisation;
+  it needs the spindle on clockwise (M3).  G88 feeds in, dwells, stops the
+  spindle and pauses the program so the operator can withdraw the tool by
+  hand, then restarts the spindle; it needs the spindle on.
+* Not supported (clear error): G76, G87, G10 L2/L20 rotation (R).
 """
 
 from __future__ import annotations
@@ -36,8 +41,8 @@ ZERO9: C.Pose = (0.0,) * 9  # type: ignore[assignment]
 #: plane -> (first axis, second axis, normal axis, first/second centre words)
 PLANES = {170: (0, 1, 2, "ij"), 180: (2, 0, 1, "ki"), 190: (1, 2, 0, "jk")}
 COORD_CODES = (540, 550, 560, 570, 580, 590, 591, 592, 593)
-CANNED = (730, 810, 820, 830, 850, 860, 890)
-UNSUPPORTED_MOTION = {760: "G76", 840: "G84", 870: "G87", 880: "G88"}
+CANNED = (730, 810, 820, 830, 840, 850, 860, 880, 890)
+UNSUPPORTED_MOTION = {760: "G76", 870: "G87"}
 
 
 def _pose(values: Any) -> C.Pose:
@@ -814,11 +819,16 @@ class Interpreter:
                 self.cycle[letter] = block.words[letter]
         for letter in ("r", dl):
             if letter not in self.cycle:
-                raise block.error(f"canned cycle G{motion / 10:g} needs an "
-                                  f"{letter.upper()} word", key)
+                raise block.error(f"canned cycle G{motion / 10:g} needs "
+                                  f"the word {letter.upper()}", key)
         if motion in (730, 830) and self.cycle.get("q", 0) <= 0:
             raise block.error(f"G{motion / 10:g} needs a positive Q word",
                               key)
+        if motion == 840 and self.modal.spindle != 30:
+            raise block.error("G84 needs the spindle turning clockwise (M3)",
+                              key)
+        if motion == 880 and self.modal.spindle == 50:
+            raise block.error("G88 needs the spindle turning", key)
         repeats = int(block.words.get("l", 1))
         if repeats < 0:
             raise block.error("L must not be negative", "l")
@@ -880,10 +890,22 @@ class Interpreter:
                     rapid(depth + delta)
             return
         feed(bottom)
-        if motion in (820, 890) and self.cycle.get("p", 0) > 0:
+        if motion == 840:
+            self._emit(C.SpindleOff(line))
+            self._emit(C.SpindleOn(-1, self.speed, line))
+        if motion in (820, 840, 880, 890) and self.cycle.get("p", 0) > 0:
             self._emit(C.Dwell(self.cycle["p"], line))
         if motion in (850, 890):
             feed(r)
+        elif motion == 840:
+            feed(r)
+            self._emit(C.SpindleOff(line))
+            self._emit(C.SpindleOn(1, self.speed, line))
+        elif motion == 880:
+            self._emit(C.SpindleOff(line))
+            self._emit(C.ProgramPause(line))
+            self._emit(C.SpindleOn(1 if self.modal.spindle == 30 else -1,
+                                   self.speed, line))
         elif motion == 860:
             self._emit(C.SpindleOff(line))
             rapid(r)
