@@ -206,8 +206,10 @@ def test_errors_name_file_and_line(machine, tmp_path):
     assert any(k == "error" and f"{path}:3:" in t for k, t in errors)
     st = m.status()
     assert st.interp_state is InterpState.IDLE
-    assert st.task_state is TaskState.ON
+    # bad input leaves the machine safe: off, motion disabled
+    assert st.task_state is TaskState.ESTOP_RESET and not st.enabled
     # a probe without contact is reported with its line too
+    m.state(TaskState.ON)
     path.write_text("G21 G90 G0 Z50\nG38.2 Z40 F600\nM2\n")
     m.program_open(str(path))
     m.program_run()
@@ -350,22 +352,46 @@ def test_from_launcher_reads_the_emcio_section(tmp_path, monkeypatch):
     text = (mill / "mill3.ini").read_text().replace(
         "HALFILE = mill3.hal", f"HALFILE = {mill / 'mill3.hal'}")
     text += "\n[EMCIO]\nTOOL_TABLE = tool.tbl\nRANDOM_TOOLCHANGER = 1\n"
+    text += ("\n[RS274NGC]\nPARAMETER_FILE = mill.var\n"
+             "SUBROUTINE_PATH = subs\n")
     (tmp_path / "mill.ini").write_text(text)
     (tmp_path / "tool.tbl").write_text("T0 P0\nT4 P3 Z7\n")
+    (tmp_path / "mill.var").write_text("5221 12.5\n")
+    (tmp_path / "subs").mkdir()
+    (tmp_path / "subs" / "seven.ngc").write_text(
+        "o<seven> sub\n#<_value> = 7\no<seven> endsub [7]\n")
     launcher = Launcher(str(tmp_path / "mill.ini"))
     launcher.start(realtime=False)
+    m = None
     try:
         m = Machine.from_launcher(launcher)
         assert m.io.table.random and m.io.table.tools() == [0, 4]
         assert m.io.table.path == str(tmp_path / "tool.tbl")
+        # [RS274NGC]: the var file is read, subroutines are found
+        assert m.params.get(5221) == 12.5
+        assert m.subroutine_path == [str(tmp_path / "subs")]
+        m.params.set(5222, 3.0)
+        m.save_parameters()
+        assert "5222" in (tmp_path / "mill.var").read_text()
         launcher.hal.setp(P + "emc-enable-in", True)
         m.state(TaskState.ESTOP_RESET)
         m.state(TaskState.ON)
         assert m.status().enabled
+        m.home()
+        prog = tmp_path / "p.ngc"
+        prog.write_text("G21 G90\no<seven> call\nG0 X#<_value>\nM2\n")
+        m.mode(TaskMode.AUTO)
+        m.program_open(str(prog))
+        m.program_run()
+        m.wait_program(timeout=30)
+        # X7 from the subroutine, in G54 whose X offset #5221 = 12.5 came
+        # from the var file
+        assert m.status().position[0] == pytest.approx(7 + 12.5)
         m.state(TaskState.ESTOP)
         assert not m.status().enabled
-        m.io.close()
     finally:
+        if m is not None:
+            m.io.close()
         launcher.shutdown()
 
 

@@ -11,6 +11,7 @@ so a whole session is deterministic.
 from __future__ import annotations
 
 import copy
+import os
 import time
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -79,6 +80,10 @@ class Machine:
         self.io = io
         self.task = Task(motion, io)
         self.params = Parameters()
+        #: [RS274NGC]SUBROUTINE_PATH: folders searched for o<name> call
+        self.subroutine_path: list[str] = []
+        #: [RS274NGC]PARAMETER_FILE: persistent parameters (var file)
+        self.parameter_file: Optional[str] = None
         self.units = units
         self._errors: list[tuple[str, str]] = []
         self.executor = Executor(motion, io, hal, thread=thread,
@@ -107,7 +112,6 @@ class Machine:
                          ).strip() not in ("0", "")
             table = ToolTable(random=random)
             if name:
-                import os
                 path = name if os.path.isabs(name) else os.path.join(
                     os.path.dirname(os.path.abspath(ini.path)), name)
                 table = ToolTable.load(path, random=random)
@@ -115,8 +119,26 @@ class Machine:
             io.attach(launcher.hal, thread)
         units = str(ini.get("TRAJ", "LINEAR_UNITS") or "mm").strip().lower()
         units = "inch" if units in ("inch", "in", "imperial") else "mm"
-        return cls(launcher.hal, launcher.motion, io, units=units,
-                   thread=thread)
+        machine = cls(launcher.hal, launcher.motion, io, units=units,
+                      thread=thread)
+        folder = os.path.dirname(os.path.abspath(ini.path))
+        paths = ini.get("RS274NGC", "SUBROUTINE_PATH")
+        if paths:
+            machine.subroutine_path = [
+                os.path.join(folder, p.strip()) for p in paths.split(":")
+                if p.strip()]
+        name = ini.get("RS274NGC", "PARAMETER_FILE")
+        if name:
+            machine.parameter_file = os.path.join(folder, name)
+            if os.path.exists(machine.parameter_file):
+                machine.params.load(machine.parameter_file)
+        return machine
+
+    def save_parameters(self) -> None:
+        """Write the persistent parameters to [RS274NGC]PARAMETER_FILE
+        (atomically), as LinuxCNC does when it exits."""
+        if self.parameter_file:
+            self.params.save(self.parameter_file)
 
     def _new_interp(self) -> Interpreter:
         tools = copy.deepcopy(self.io.table)
@@ -235,8 +257,8 @@ class Machine:
             time.sleep(0.001)
 
     def _guard(self, fn: Any) -> Any:
-        """Run fn; on an error stop the machine's moves, report it and
-        raise it as MachineError."""
+        """Run fn; on an error stop the machine's moves, turn it off
+        (motion disabled), report it and raise it as MachineError."""
         try:
             return fn()
         except GCodeError as e:
@@ -245,6 +267,9 @@ class Machine:
             text = f"{self._source}:{self.interp.line}: {e}"
         self._errors.append(("error", text))
         self._stop_program()
+        # bad input leaves the machine safe: motion off until turned on
+        if self.task.state is TaskState.ON:
+            self.task.set_state(TaskState.OFF)
         raise MachineError(text)
 
     # -- programs --------------------------------------------------------
@@ -252,7 +277,8 @@ class Machine:
     def program_open(self, path: str) -> None:
         """``command.program_open``."""
         self.task.require_idle("program open")
-        self._program = Program.from_file(path, self.params)
+        self._program = Program.from_file(path, self.params,
+                                          self.subroutine_path)
         self.file = path
         self._blocks = None
 
@@ -266,7 +292,9 @@ class Machine:
         self.task.require_idle("program run")
         if self._program is None:
             raise MachineError("program run refused: no program open")
-        program = Program.from_file(self.file, self.params)
+        # read again: a run starts from the file as it is now
+        program = Program.from_file(self.file, self.params,
+                                    self.subroutine_path)
         self._blocks = program.blocks()
         self._source = self.file
         self._start_line = start_line
