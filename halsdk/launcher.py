@@ -4,14 +4,19 @@ What the launcher does, in order:
 
 1. reads the INI file; a missing ``[HAL]HALFILE`` is an error naming the
    file;
-2. creates the HAL instance (this process is its host) and runs every
+2. creates the HAL instance (this process is its host); when the INI file
+   has an ``[EMCIO]`` section, makes the I/O controller ``iocontrol.0``
+   (:class:`halsdk.machine.IoControl`, its tool table from
+   ``[EMCIO]TOOL_TABLE`` and ``RANDOM_TOOLCHANGER``) first, so that the
+   HAL files can wire its pins, as LinuxCNC starts ``io`` before them;
+   then runs every
    ``[HAL]HALFILE`` (relative to the INI file's folder; two passes when
    ``[HAL]TWOPASS`` is set) and ``[HAL]HALCMD`` with ``[SECTION]KEY``
    substitution from the INI file; the first error (``file:line: ...``)
    stops the start;
 3. when the HAL files loaded the motion module, configures it from the
    INI file (:meth:`halsdk.motion.Motion.configure_ini`: [KINS], [TRAJ],
-   [JOINT_n], [AXIS_L]);
+   [JOINT_n], [AXIS_L]); the I/O controller runs in ``servo-thread``;
 4. starts the realtime threads and runs ``[HAL]POSTGUI_HALFILE``;
 5. runs until SIGINT (Ctrl-C) or SIGTERM, or for ``seconds`` when given;
 6. shuts down: motion disabled, ``[HAL]SHUTDOWN`` run, threads stopped,
@@ -56,6 +61,7 @@ class Launcher:
         self.out, self.err = out, err
         self.hal: Any = None
         self.motion: Any = None
+        self.io: Any = None             # the I/O controller, with [EMCIO]
         self._stop = threading.Event()
 
     # ------------------------------------------------------------ start
@@ -76,9 +82,12 @@ class Launcher:
                                   f"cannot read HAL file '{name}'")
         self.hal = halsdk.Hal(create=True)
         try:
+            self._start_io()
             ex = Executor(self.hal, ini=self.ini.path, register=False)
             self._load(ex, halfiles)
             self._configure_motion()
+            if self.io is not None and self.motion is not None:
+                self.io.attach(self.hal, "servo-thread")
             if realtime:
                 note = self.hal.start()
                 if note:
@@ -88,6 +97,19 @@ class Launcher:
         except BaseException:
             self.shutdown()
             raise
+
+    def _start_io(self) -> None:
+        if not self.ini.has_section("EMCIO"):
+            return
+        from halsdk.machine import IoControl, ToolTable
+        random = str(self.ini.get("EMCIO", "RANDOM_TOOLCHANGER") or "0"
+                     ).strip() not in ("0", "")
+        name = self.ini.get("EMCIO", "TOOL_TABLE")
+        if name:
+            table = ToolTable.load(_path(self.ini, name), random=random)
+        else:
+            table = ToolTable(random=random)
+        self.io = IoControl(table)
 
     def _load(self, ex: Any, halfiles: list[str]) -> None:
         if any(self.ini.all("HAL", "TWOPASS")):
@@ -147,6 +169,12 @@ class Launcher:
                 ex.run_file(_path(self.ini, name))
             hal.stop()
         finally:
+            io, self.io = self.io, None
+            if io is not None:
+                try:
+                    io.close()
+                except HalError:
+                    pass                # closed by its user already
             hal.close()
 
 

@@ -157,7 +157,7 @@ def run(out_png: Optional[str] = "demo.png", realtime: bool = False,
     """Run the demo; returns its :class:`Summary` (also printed to
     ``out``).  ``out_png`` None: no plot."""
     from halsdk.launcher import Launcher
-    from halsdk.machine import IoControl, Machine, TaskMode, TaskState, ToolTable
+    from halsdk.machine import Machine, TaskMode, TaskState
 
     folder = machine_folder()
     ini = folder / "mill.ini"
@@ -179,11 +179,10 @@ def run(out_png: Optional[str] = "demo.png", realtime: bool = False,
         print(f"mill started from {ini} "
               f"({'real time' if realtime else 'stepped, simulated time'})",
               file=out)
-        table = ToolTable.load(os.path.join(work, "tool.tbl"), random=False)
-        io = IoControl(table)
-        io.attach(hal, "servo-thread")
-        machine = Machine.from_launcher(launcher, io=io)
-        hal.source(str(folder / "toolchange.hal"))
+        # the launcher made iocontrol.0 from [EMCIO]; its table is saved
+        # to the copy, never to the shipped file
+        launcher.io.table.path = os.path.join(work, "tool.tbl")
+        machine = Machine.from_launcher(launcher)
         hal.setp("iocontrol.0.emc-enable-in", True)  # no outside E-stop
         recorder = _Recorder(hal)
         hal.add_python_function("demo-recorder", recorder,

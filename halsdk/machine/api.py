@@ -106,6 +106,8 @@ class Machine:
         if launcher.motion is None:
             raise MachineError(f"{ini.path}: the HAL files load no motion "
                                "module (motmod)")
+        if io is None and launcher.io is not None:
+            io = launcher.io            # made before the HAL files ran
         if io is None:
             name = ini.get("EMCIO", "TOOL_TABLE")
             random = str(ini.get("EMCIO", "RANDOM_TOOLCHANGER") or "0"
