@@ -9,7 +9,6 @@ from pathlib import Path
 import pytest
 
 from halsdk.errors import HalError
-from halsdk.machine import tooltable as tt
 from halsdk.machine.tooltable import ToolEntry, ToolTable, ToolTableError
 
 DATA = Path(__file__).parent / "machine"
@@ -164,7 +163,7 @@ def test_failed_save_leaves_the_old_file_and_no_temporary(
     def broken_fsync(fd):
         raise OSError(28, "No space left on device")
 
-    monkeypatch.setattr(tt.os, "fsync", broken_fsync)
+    monkeypatch.setattr(os, "fsync", broken_fsync)
     with pytest.raises(OSError, match="No space"):
         nonrandom.save()
     assert path.read_text() == before

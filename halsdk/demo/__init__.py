@@ -12,6 +12,7 @@ By default the servo thread is stepped (simulated time, deterministic);
 from __future__ import annotations
 
 import argparse
+import io
 import os
 import shutil
 import sys
@@ -19,6 +20,8 @@ import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Optional, TextIO
+
+from halsdk.atomicfile import write_atomic
 
 __all__ = ["Summary", "machine_folder", "main", "run"]
 
@@ -112,20 +115,12 @@ def _write_plot(trace: list, path: str, summary: Summary,
     ax2.set_title("tool tip Z over time (Z feedback - tool length)")
     ax2.legend(loc="best")
     fig.tight_layout()
-    folder = os.path.dirname(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(suffix=".png", dir=folder)
-    os.close(fd)
+    image = io.BytesIO()
     try:
-        fig.savefig(tmp, dpi=100)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)
-        os.replace(tmp, path)
-    except BaseException:
-        os.unlink(tmp)
-        raise
+        fig.savefig(image, format="png", dpi=100)
     finally:
         plt.close(fig)
+    write_atomic(path, image.getvalue())
     return path
 
 

@@ -2,10 +2,9 @@
 
 from __future__ import annotations
 
-import os
-import shutil
-import tempfile
 from typing import Callable, Optional, Union
+
+from halsdk.atomicfile import write_atomic
 
 from .errors import GCodeError
 
@@ -203,20 +202,4 @@ class Parameters:
         numbers = sorted(set(PERSISTENT) | self._saved)
         text = "".join(f"{n}\t{self._numbered.get(n, 0.0):.6f}\n"
                        for n in numbers)
-        directory = os.path.dirname(os.path.abspath(path))
-        fd, tmp = tempfile.mkstemp(prefix=".var-", dir=directory)
-        try:
-            with os.fdopen(fd, "w", encoding="utf-8") as stream:
-                stream.write(text)
-                stream.flush()
-                os.fsync(stream.fileno())
-            if os.path.exists(path):
-                shutil.copyfile(path, path + ".bak")
-                shutil.copymode(path, tmp)
-            else:
-                os.chmod(tmp, 0o644)
-            os.replace(tmp, path)
-        except BaseException:
-            if os.path.exists(tmp):
-                os.unlink(tmp)
-            raise
+        write_atomic(path, text, backup=True)

@@ -27,13 +27,12 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import os
-import tempfile
 from collections.abc import Iterator
 from dataclasses import dataclass
 from decimal import Decimal
 from typing import Optional
 
+from halsdk.atomicfile import write_atomic
 from halsdk.errors import HalError
 
 __all__ = ["AXES", "EMPTY", "MAX_RANDOM_POCKET", "ToolEntry", "ToolTable",
@@ -278,20 +277,7 @@ class ToolTable:
         if not path:
             raise ToolTableError("no file to save the tool table to")
         text = "".join(line + "\n" for line in self.lines())
-        folder = os.path.dirname(os.path.abspath(path))
-        fd, tmp = tempfile.mkstemp(prefix=".tooltable-", dir=folder)
-        try:
-            with os.fdopen(fd, "w", encoding="utf-8") as f:
-                f.write(text)
-                f.flush()
-                os.fsync(f.fileno())
-            os.replace(tmp, path)
-        except BaseException:
-            try:
-                os.unlink(tmp)
-            except OSError:
-                pass
-            raise
+        write_atomic(path, text)
 
     def _autosave(self) -> None:
         if self.path:
