@@ -62,7 +62,7 @@ def _write(path, text):
         f.write(text)
 
 
-def comp_extension(path):
+def comp_extension(path, package="halsdk.components"):
     """The extension module of one shipped ``.comp`` file."""
     try:
         comp = parse_file(path)
@@ -78,13 +78,13 @@ def comp_extension(path):
         text, _ = gen_cython.generate(comp)
         pyx = os.path.join(GENERATED, comp.name + ".pyx")
         _write(pyx, text)
-        return Extension("halsdk.components." + comp.name, sources=[pyx],
+        return Extension(f"{package}.{comp.name}", sources=[pyx],
                          include_dirs=["halsdk/include", "components"],
                          extra_compile_args=flags, extra_link_args=links)
     c_file = os.path.join(GENERATED, comp.name + ".c")
     _write(c_file, gen_c.generate(comp, os.path.abspath(c_file)))
     return Extension(
-        "halsdk.components." + comp.name,
+        f"{package}.{comp.name}",
         sources=["halsdk/src/c_module.c", c_file],
         include_dirs=["halsdk/include", "components"],
         define_macros=[("HALSDK_MODULE_NAME", comp.name),
@@ -94,6 +94,9 @@ def comp_extension(path):
 
 components = [comp_extension(p)
               for p in sorted(glob.glob("components/*.comp"))]
+# drivers: the same contract, installed as halsdk.drivers.<name>
+components += [comp_extension(p, "halsdk.drivers")
+               for p in sorted(glob.glob("drivers/*.comp"))]
 components += [
     Extension(
         "halsdk.components." + os.path.splitext(os.path.basename(src))[0],
@@ -168,9 +171,10 @@ setup(
     packages=["halsdk", "halsdk.compat", "halsdk.demo", "halsdk.halcmd",
               "halsdk.components", "halsdk.gcode", "halsdk.machine",
               "halsdk.motion", "halsdk.tools", "halcompile",
-              "halsdk.demo.mill"],
+              "halsdk.demo.mill", "halsdk.driver", "halsdk.drivers"],
     # the demo's machine is examples/mill, installed as package data
     package_dir={"halsdk.components": "components",
+                 "halsdk.drivers": "drivers",
                  "halsdk.demo.mill": "examples/mill"},
     ext_modules=cythonize([core] + components, language_level=3, quiet=True,
                           include_path=["."]),

@@ -23,8 +23,9 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 DOCS = os.path.join(ROOT, "docs")
 PAGES = ["index", "concepts", "tutorial", "components", "halcmd",
          "halcompile", "python-api", "cython-components", "c-components",
-         "motion", "running", "machine", "tooltable", "gcode", "homing",
-         "kinematics", "design", "compat", "benchmarks"]
+         "motion", "running", "machine", "tooltable", "gcode", "drivers",
+         "driver-sim-io", "homing", "kinematics", "design", "compat",
+         "benchmarks"]
 
 
 @pytest.fixture(scope="module")
@@ -57,11 +58,13 @@ def test_every_page_is_built(site: str) -> None:
 
 
 def test_each_shipped_comp_has_a_generated_page(site: str) -> None:
-    """The page of every ``components/*.comp`` is written by halcompile's
-    --document writer and listed on the components page."""
+    """The page of every ``components/*.comp`` and ``drivers/*.comp`` is
+    written by halcompile's --document writer and listed on the components
+    page."""
     from halcompile.parser import parse_file
 
-    comps = sorted(glob.glob(os.path.join(ROOT, "components", "*.comp")))
+    comps = sorted(glob.glob(os.path.join(ROOT, "components", "*.comp"))
+                   + glob.glob(os.path.join(ROOT, "drivers", "*.comp")))
     assert len(comps) >= 4
     listing = _read(site, "components")
     for path in comps:

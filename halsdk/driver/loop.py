@@ -1,0 +1,179 @@
+"""The periodic I/O loop of a userspace driver: read, write, timing
+statistics, reconnect with exponential back-off, stop on a signal."""
+
+from __future__ import annotations
+
+import signal
+import threading
+import time
+from typing import Callable, Optional
+
+from halsdk.driver.base import (
+    FAULT_OPEN,
+    FAULT_READ,
+    FAULT_WRITE,
+    Driver,
+    DriverError,
+    log,
+)
+from halsdk.errors import HalError
+
+#: timing pins created on the driver's component (float, seconds)
+STAT_PINS = ("period", "max-period", "read-time", "write-time")
+
+
+class IOLoop:
+    """Run ``driver`` every ``period`` seconds.
+
+    Each :meth:`cycle` either tries to (re)open a disconnected device --
+    no sooner than the back-off delay allows -- or calls ``read()`` then
+    ``write()``.  An exception from open, read or write sets the fault
+    pins, closes the device and schedules a reconnect after ``backoff``
+    seconds, doubling up to ``backoff_max`` while attempts keep failing;
+    the first fully successful cycle clears the fault and resets the delay.
+
+    Statistics pins on ``<device>.<num>``: ``period`` (time between the
+    last two cycles), ``max-period`` (largest period seen; write 0 to
+    restart it), ``read-time`` and ``write-time`` (duration of the last
+    read and write).
+
+    ``clock`` and ``sleep`` are replaceable: tests pass a fake clock and
+    call :meth:`cycle` themselves.
+    """
+
+    def __init__(self, driver: Driver, period: float = 0.01,
+                 backoff: float = 0.1, backoff_max: float = 5.0,
+                 clock: Callable[[], float] = time.monotonic,
+                 sleep: Optional[Callable[[float], None]] = None):
+        if period <= 0 or backoff <= 0 or backoff_max < backoff:
+            raise ValueError("period and backoff must be > 0 and "
+                             "backoff_max >= backoff")
+        self.driver = driver
+        self.period = period
+        self.backoff = backoff
+        self.backoff_max = backoff_max
+        self.clock = clock
+        self._stop = threading.Event()
+        self.sleep = sleep or self._stop.wait
+        self.connected = False
+        self.delay = backoff          # next back-off delay
+        self.next_attempt = 0.0       # clock time of the next open attempt
+        self._last_start: Optional[float] = None
+        self._thread: Optional[threading.Thread] = None
+
+    # -- setup -------------------------------------------------------------
+    def start(self) -> None:
+        """Create the driver's component (if not done) with the stat pins."""
+        if self.driver.comp is None:
+            self.driver.start([(pin, "float") for pin in STAT_PINS])
+
+    # -- one cycle ---------------------------------------------------------
+    def cycle(self) -> None:
+        """One iteration; never raises for device errors."""
+        d = self.driver
+        comp = d.comp
+        if comp is None:
+            raise DriverError(f"{d.prefix}: call start() before cycle()")
+        now = self.clock()
+        if self._last_start is not None:
+            comp["period"] = now - self._last_start
+            if comp["period"] > comp["max-period"]:
+                comp["max-period"] = comp["period"]
+        self._last_start = now
+        if not self.connected:
+            if now < self.next_attempt:
+                return
+            try:
+                d.open()
+            except Exception as exc:
+                self._failed(FAULT_OPEN, exc, now)
+                return
+            self.connected = True
+            comp["connected"] = True
+        stage = FAULT_READ
+        try:
+            t0 = self.clock()
+            d.read()
+            t1 = self.clock()
+            stage = FAULT_WRITE
+            d.write()
+            t2 = self.clock()
+        except Exception as exc:
+            self._failed(stage, exc, now)
+            return
+        comp["read-time"] = t1 - t0
+        comp["write-time"] = t2 - t1
+        self.delay = self.backoff
+        d.clear_fault()
+
+    def _failed(self, code: int, exc: BaseException, now: float) -> None:
+        d = self.driver
+        d.set_fault(code, exc)
+        if self.connected:
+            d.safe_close()
+            self.connected = False
+            d.comp["connected"] = False
+        self.next_attempt = now + self.delay
+        log.info("%s: reconnect in %.3g s", d.prefix, self.delay)
+        self.delay = min(self.delay * 2, self.backoff_max)
+
+    # -- running -----------------------------------------------------------
+    def run(self, handle_signals: bool = True) -> None:
+        """Start, cycle every period until :meth:`stop` (or SIGTERM/SIGINT
+        when ``handle_signals`` and on the main thread) or until the
+        component is removed (``unloadusr``), then close the device and
+        remove the component.  For ``loadusr`` processes; a component that
+        cannot be created ends the process with a message and status 1."""
+        old = {}
+        if handle_signals and threading.current_thread() is \
+                threading.main_thread():
+            for sig in (signal.SIGTERM, signal.SIGINT):
+                old[sig] = signal.signal(sig, lambda *_: self.stop())
+        try:
+            try:
+                self.start()
+            except HalError as exc:
+                log.error("%s: cannot create the component: %s",
+                          self.driver.prefix, exc)
+                raise SystemExit(1) from None
+            deadline = self.clock()
+            while not self._stop.is_set():
+                comp = self.driver.comp
+                if comp is None or not comp.exists:
+                    log.warning("%s: component removed, stopping",
+                                self.driver.prefix)
+                    break
+                try:
+                    self.cycle()
+                except HalError:
+                    if comp.exists:
+                        raise
+                    continue        # removed mid-cycle: reported above
+                deadline += self.period
+                wait = deadline - self.clock()
+                if wait < 0:       # overrun: do not try to catch up
+                    deadline = self.clock()
+                    wait = 0.0
+                self.sleep(wait)
+        finally:
+            if self.connected:
+                self.connected = False
+            self.driver.shutdown()
+            for sig, handler in old.items():
+                signal.signal(sig, handler)
+
+    def start_thread(self) -> threading.Thread:
+        """Run the loop in a daemon thread (no signal handling)."""
+        self.start()
+        self._thread = threading.Thread(
+            target=self.run, kwargs={"handle_signals": False},
+            name=f"{self.driver.prefix}-io", daemon=True)
+        self._thread.start()
+        return self._thread
+
+    def stop(self, timeout: Optional[float] = 5.0) -> None:
+        """Ask the loop to end; wait for its thread if it has one."""
+        self._stop.set()
+        t = self._thread
+        if t is not None and t is not threading.current_thread():
+            t.join(timeout)
