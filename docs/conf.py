@@ -20,13 +20,16 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 
 
 def write_component_pages() -> None:
-    """One page per shipped ``.comp`` (``components/``), made by
-    halcompile's ``--document`` writer, into ``docs/comp/`` (generated,
-    not kept in git).  A page whose .comp is gone is removed."""
+    """One page per shipped ``.comp`` (``components/``, ``drivers/``),
+    made by halcompile's ``--document`` writer, into ``docs/comp/``
+    (generated, not kept in git).  A page whose .comp is gone is
+    removed."""
     out = os.path.join(HERE, "comp")
     os.makedirs(out, exist_ok=True)
     sources = sorted(glob.glob(os.path.join(HERE, "..", "components",
-                                            "*.comp")))
+                                            "*.comp"))
+                     + glob.glob(os.path.join(HERE, "..", "drivers",
+                                              "*.comp")))
     wanted = set()
     for path in sources:
         comp = parse_file(path)

@@ -1,0 +1,1 @@
+"""The drivers that ship with halsdk (``loadrt NAME`` finds them here)."""
