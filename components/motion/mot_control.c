@@ -202,10 +202,25 @@ void mot_axis_limits_to_planner(int n)
 }
 
 /* every planner at rest where the machine is now */
+/* carte_pos_cmd from the joints' pos_cmd, when the forward kinematics
+   can be trusted (otherwise it keeps its value) */
+static void carte_cmd_from_joints(void)
+{
+    double jt[MOT_MAX_JOINTS];
+    EmcPose p;
+    int i;
+
+    if (!kins_valid())
+        return;
+    for (i = 0; i < mot->num_joints; i++)
+        jt[i] = mot->joints[i].pos_cmd;
+    if (mot_forward(jt, &p) == 0)
+        mot->carte_pos_cmd = p;
+}
+
 void mot_sync_planners(void)
 {
     int i;
-    EmcPose p;
 
     for (i = 0; i < mot->num_joints; i++) {
         mot_joint_t *j = &mot->joints[i];
@@ -215,13 +230,7 @@ void mot_sync_planners(void)
         j->vel_cmd = j->acc_cmd = 0.0;
         mot->jog_kind[i] = MOT_JOG_NONE;
     }
-    if (kins_valid()) {
-        double jt[MOT_MAX_JOINTS];
-        for (i = 0; i < mot->num_joints; i++)
-            jt[i] = mot->joints[i].pos_cmd;
-        if (mot_forward(jt, &p) == 0)
-            mot->carte_pos_cmd = p;
-    }
+    carte_cmd_from_joints();
     for (i = 0; i < MOT_MAX_AXES; i++) {
         fp_reset(&mot->axis[i].tp, *emcpose_axis(&mot->carte_pos_cmd, i));
         mot_axis_limits_to_planner(i);
@@ -891,14 +900,7 @@ void mot_controller(void *arg, long period)
             fp_reset(&j->free_tp, j->pos_cmd);
             mot->jog_kind[i] = MOT_JOG_NONE;
         }
-        if (kins_valid()) {
-            double jt[MOT_MAX_JOINTS];
-            EmcPose p;
-            for (i = 0; i < mot->num_joints; i++)
-                jt[i] = mot->joints[i].pos_cmd;
-            if (mot_forward(jt, &p) == 0)
-                mot->carte_pos_cmd = p;
-        }
+        carte_cmd_from_joints();
         for (i = 0; i < MOT_MAX_AXES; i++) {
             fp_reset(&mot->axis[i].tp, *emcpose_axis(&mot->carte_pos_cmd, i));
             mot->axis[i].jog = MOT_JOG_NONE;
@@ -927,14 +929,7 @@ void mot_controller(void *arg, long period)
     } else if (mot->mode == MOT_MODE_FREE) {
         for (i = 0; i < mot->num_joints; i++)
             run_free_joint(i, dt);
-        if (kins_valid()) {
-            double jt[MOT_MAX_JOINTS];
-            EmcPose p;
-            for (i = 0; i < mot->num_joints; i++)
-                jt[i] = mot->joints[i].pos_cmd;
-            if (mot_forward(jt, &p) == 0)
-                mot->carte_pos_cmd = p;
-        }
+        carte_cmd_from_joints();
         for (i = 0; i < MOT_MAX_AXES; i++) {
             mot->axis[i].vel_cmd = 0;
             fp_reset(&mot->axis[i].tp, *emcpose_axis(&mot->carte_pos_cmd, i));
