@@ -8,7 +8,9 @@ home/limit switches, named like the pins of a real board
 to inputs so that a machine configuration can be exercised without hardware:
 digital output MM drives digital input MM, analog output MM drives analog input
 MM, encoders count a simulated motor position (for example the feedback of a
-stepgen) and switches follow a simulated axis position.
+stepgen) or the step and direction or quadrature pulses wired to their
+phase-A and phase-B inputs (for example the outputs of a stepgen), and
+switches follow a simulated axis position.
 
 Load with \\fBloadrt sim_io num_boards=\\fIB\\fR and the channel counts
 \\fBnum_digin\\fR, \\fBnum_digout\\fR, \\fBnum_adcin\\fR, \\fBnum_dacout\\fR,
@@ -17,7 +19,11 @@ Load with \\fBloadrt sim_io num_boards=\\fIB\\fR and the channel counts
 Add \\fBsim-io.\\fIN\\fB.write\\fR to a thread after the functions that compute the
 outputs and \\fBsim-io.\\fIN\\fB.read\\fR before those that use the inputs.
 \\fBwrite\\fR latches the output pins into the simulated hardware; \\fBread\\fR
-updates the input pins from it.
+updates the input pins from it.  An encoder that counts pulses
+(\\fBsim-source\\fR 1 or 2) sees its inputs only when \\fBread\\fR runs: put
+\\fBread\\fR in the thread of the pulse generator, after it, so that it
+samples every change (e.g. after \\fBstepgen.make-pulses\\fR in the base
+thread, which then needs floating point, as \\fBread\\fR uses it).
 
 The canonical interface names some params with underscores, which a pin
 list here cannot show; each analog channel also has these params (rw):
@@ -64,9 +70,12 @@ pin out float encoder.MM.position "count / position-scale";
 pin out float encoder.MM.velocity "Change of position per second over the last period";
 pin in bit encoder.MM.reset "While true count is held at zero";
 pin io bit encoder.MM.index_enable "Set true to zero the count at the next index pulse; cleared by the driver when that happens";
-pin in float encoder.MM.sim_position "Simulated motor position (e.g. a stepgen position-fb); the counter reads sim-position * position-scale rounded to the nearest whole count";
+pin in float encoder.MM.sim_position "Simulated motor position (e.g. a stepgen position-fb), used when sim-source is 0; the counter reads sim-position * position-scale rounded to the nearest whole count";
+pin in bit encoder.MM.phase_A "Encoder input A.  sim-source 1: step, each rising edge is one count (e.g. a stepgen step output); sim-source 2: quadrature channel A";
+pin in bit encoder.MM.phase_B "Encoder input B.  sim-source 1: direction, sampled at the step edge, high counts down (as a stepgen dir output); sim-source 2: quadrature channel B, which A leads when counting up";
 param rw float encoder.MM.position_scale = 1.0 "Counts per unit of position";
 param rw s32 encoder.MM.sim_counts_per_rev = 1000 "An index pulse occurs at every multiple of this many counts (0: no index)";
+param rw s32 encoder.MM.sim_source = 0 "What the counter counts: 0 follows sim-position, 1 counts step and direction on phase-A and phase-B, 2 decodes quadrature on phase-A and phase-B (a change of both in one read is not counted); changing it keeps the count where it is; other values stop the counter and log an error once";
 
 pin in float switch.MM.position "Simulated axis position";
 pin out bit switch.MM.home "True at or above home-pos";
@@ -113,16 +122,26 @@ typedef struct {
     double volts;               /* level at the simulated output terminal */
 } dacout_t;
 
+/* the sim-source values; SRC_NONE is the state before the first read
+   and while sim-source is out of range */
+#define SRC_NONE -1
+#define SRC_POSITION 0
+#define SRC_STEP_DIR 1
+#define SRC_QUADRATURE 2
+
 typedef struct {
     hal_s32_t *count;
     hal_float_t *position, *velocity, *sim_position;
-    hal_bit_t *reset, *index_enable;
+    hal_bit_t *reset, *index_enable, *phase_a, *phase_b;
     hal_float_t position_scale;
-    hal_s32_t counts_per_rev;
+    hal_s32_t counts_per_rev, source;
     long long raw;              /* simulated counter, never reset */
     long long base;             /* raw value where count is zero */
     double old_pos;
-    int primed;
+    int mode;                   /* source used by the last read */
+    int old_a, old_b;           /* input levels seen by the last read */
+    int warned;
+    char name[HAL_NAME_LEN + 1];    /* for messages */
 } encoder_t;
 
 typedef struct {
@@ -177,53 +196,100 @@ static int trip_low(int old, double pos, double trip, double hyst)
     return 0;
 }
 
+/* counter value of the simulated position: the nearest whole count; a
+   stepgen's position-fb carries a fraction of a step, rounding it gives
+   back the stepgen's own step count */
+static long long position_counts(const encoder_t *e, double scale)
+{
+    double pos = floor(*e->sim_position * scale + 0.5);
+
+    if (pos != pos)
+        return e->raw;                  /* NaN: the counter stands still */
+    if (pos > 1e15)
+        return 1000000000000000LL;      /* keep the conversion defined */
+    if (pos < -1e15)
+        return -1000000000000000LL;
+    return (long long)pos;
+}
+
+/* place of the A/B levels in the quadrature cycle; counting up it runs
+   0 1 2 3 0 ..., so A rises a quarter cycle before B */
+static int quad_state(int a, int b)
+{
+    return a ? (b ? 2 : 1) : (b ? 3 : 0);
+}
+
+/* an index pulse sits at every multiple of counts-per-rev: when armed,
+   take the first one passed between the old counter and raw */
+static void take_index(encoder_t *e, long long raw)
+{
+    long long cpr = e->counts_per_rev;
+    long long lo = raw > e->raw ? e->raw : raw;
+    long long hi = raw > e->raw ? raw : e->raw;
+    long long idx;
+
+    if (cpr <= 0 || !*e->index_enable || raw == e->raw)
+        return;
+    if (raw > e->raw) {
+        /* first multiple in (lo, hi] */
+        idx = (lo >= 0 ? lo / cpr + 1 : -((-lo) / cpr)) * cpr;
+        if (idx > hi)
+            return;
+    } else {
+        /* first multiple in [lo, hi) going down: the largest <= hi - 1 */
+        long long h = hi - 1;
+        idx = (h >= 0 ? h / cpr : -((-h + cpr - 1) / cpr)) * cpr;
+        if (idx < lo)
+            return;
+    }
+    e->base = idx;
+    *e->index_enable = 0;
+}
+
 static void encoder_read(encoder_t *e, long period)
 {
     double scale = e->position_scale;
-    double pos = *e->sim_position;
-    long long raw, cpr = e->counts_per_rev;
+    int src = e->source;
+    int a = *e->phase_a != 0, b = *e->phase_b != 0;
+    long long raw = e->raw;
 
     if (scale == 0.0) scale = 1.0;      /* avoid dividing by zero */
-    /* nearest whole count: a stepgen's position-fb carries a fraction of
-       a step, rounding it gives back the stepgen's own step count */
-    pos = floor(pos * scale + 0.5);
-    if (pos != pos)
-        raw = e->raw;                   /* NaN: the counter stands still */
-    else if (pos > 1e15)
-        raw = 1000000000000000LL;       /* keep the conversion defined */
-    else if (pos < -1e15)
-        raw = -1000000000000000LL;
-    else
-        raw = (long long)pos;
-    if (!e->primed) {
-        /* first sample: start counting from here, nothing has moved yet */
-        e->raw = raw;
-        e->base = raw;
-        e->primed = 1;
+    if (src < SRC_POSITION || src > SRC_QUADRATURE) {
+        if (!e->warned)
+            rtapi_print_msg(RTAPI_MSG_ERR,
+                "sim_io: %s.sim-source=%d is not 0, 1 or 2; "
+                "the counter stands still\n", e->name, src);
+        e->warned = 1;
+        src = SRC_NONE;
+    } else {
+        e->warned = 0;
     }
-    if (cpr > 0 && *e->index_enable && raw != e->raw) {
-        /* an index pulse sits at every multiple of counts-per-rev; find
-           the first one passed between the old and the new counter */
-        long long lo = raw > e->raw ? e->raw : raw;
-        long long hi = raw > e->raw ? raw : e->raw;
-        long long idx;
-        if (raw > e->raw) {
-            /* first multiple in (lo, hi] */
-            idx = (lo >= 0 ? lo / cpr + 1 : -((-lo) / cpr)) * cpr;
-            if (idx <= hi) {
-                e->base = idx;
-                *e->index_enable = 0;
-            }
-        } else {
-            /* first multiple in [lo, hi) going down: the largest <= hi - 1 */
-            long long h = hi - 1;
-            idx = (h >= 0 ? h / cpr : -((-h + cpr - 1) / cpr)) * cpr;
-            if (idx >= lo) {
-                e->base = idx;
-                *e->index_enable = 0;
-            }
+    if (src != e->mode) {
+        /* first read or a new source: start from the input as it is now,
+           without counting, so that count carries on where it was */
+        if (src == SRC_POSITION) {
+            raw = position_counts(e, scale);
+            e->base += raw - e->raw;
+            e->raw = raw;
         }
+        e->mode = src;
+    } else if (src == SRC_POSITION) {
+        raw = position_counts(e, scale);
+    } else if (src == SRC_STEP_DIR) {
+        if (a && !e->old_a)
+            raw += b ? -1 : 1;
+    } else if (src == SRC_QUADRATURE) {
+        /* one step along the cycle is one count; a jump of two (both
+           inputs changed since the last read) has no direction */
+        int d = (quad_state(a, b) - quad_state(e->old_a, e->old_b)) & 3;
+        if (d == 1)
+            raw++;
+        else if (d == 3)
+            raw--;
     }
+    e->old_a = a;
+    e->old_b = b;
+    take_index(e, raw);
     e->raw = raw;
     if (*e->reset) e->base = raw;
     *e->count = (hal_s32_t)(raw - e->base);
@@ -379,8 +445,16 @@ static int setup_board(int n)
                 "%s.encoder.%02d.position-scale", pre, i))) return r;
         if ((r = hal_param_s32_newf(HAL_RW, &e->counts_per_rev, comp_id,
                 "%s.encoder.%02d.sim-counts-per-rev", pre, i))) return r;
+        if ((r = hal_param_s32_newf(HAL_RW, &e->source, comp_id,
+                "%s.encoder.%02d.sim-source", pre, i))) return r;
+        if ((r = hal_pin_bit_newf(HAL_IN, &e->phase_a, comp_id,
+                "%s.encoder.%02d.phase-A", pre, i))) return r;
+        if ((r = hal_pin_bit_newf(HAL_IN, &e->phase_b, comp_id,
+                "%s.encoder.%02d.phase-B", pre, i))) return r;
         e->position_scale = 1.0;
         e->counts_per_rev = 1000;
+        e->mode = SRC_NONE;
+        rtapi_snprintf(e->name, sizeof(e->name), "%s.encoder.%02d", pre, i);
     }
     for (i = 0; i < num_switch; i++) {
         switch_t *s = &b->sw[i];

@@ -2,13 +2,29 @@
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 import pytest
+from conftest import on_halsdk_path
 
 import halsdk
+from halcompile.cli import process
 from halsdk import _core
 
 P = "sim-io.0."
+SOURCE = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(
+    __file__))), "drivers", "sim_io.comp")
+
+
+@pytest.fixture(scope="module", autouse=True)
+def sim_io_from_source(tmp_path_factory: pytest.TempPathFactory):
+    """Build drivers/sim_io.comp into a folder first on HALSDK_PATH, so
+    these tests load the source and not the installed module."""
+    folder = str(tmp_path_factory.mktemp("sim-io-build"))
+    process(SOURCE, "compile", folder)
+    with on_halsdk_path(folder):
+        yield folder
 
 
 def board(hal, **counts):
@@ -44,6 +60,8 @@ def test_names_types_directions(hal):
     assert pins[P + "encoder.00.reset"] == (_core.BIT, _core.IN)
     assert pins[P + "encoder.00.index-enable"] == (_core.BIT, _core.IO)
     assert pins[P + "encoder.00.sim-position"] == (_core.FLOAT, _core.IN)
+    assert pins[P + "encoder.00.phase-A"] == (_core.BIT, _core.IN)
+    assert pins[P + "encoder.00.phase-B"] == (_core.BIT, _core.IN)
     assert pins[P + "switch.00.position"] == (_core.FLOAT, _core.IN)
     for s in ("home", "pos-limit", "neg-limit"):
         assert pins[P + "switch.00." + s] == (_core.BIT, _core.OUT)
@@ -54,13 +72,15 @@ def test_names_types_directions(hal):
                  "dacout.00.high_limit", "dacout.00.low_limit",
                  "adcin.00.bit_weight", "adcin.00.hw_offset",
                  "dacout.00.bit_weight", "dacout.00.hw_offset",
-                 "encoder.00.position-scale", "switch.00.home-pos",
+                 "encoder.00.position-scale", "encoder.00.sim-source",
+                 "encoder.00.sim-counts-per-rev", "switch.00.home-pos",
                  "switch.00.pos-limit-pos", "switch.00.neg-limit-pos",
                  "switch.00.hysteresis"):
         assert params[P + name][1] == _core.RW, name
     assert hal.getp(P + "dacout.00.high_limit") == 10.0
     assert hal.getp(P + "dacout.00.low_limit") == -10.0
     assert hal.getp(P + "encoder.00.position-scale") == 1.0
+    assert hal.getp(P + "encoder.00.sim-source") == 0
     functs = sorted(f.name for f in hal.functions())
     assert functs == ["sim-io.0.read", "sim-io.0.write",
                       "sim-io.1.read", "sim-io.1.write"]
@@ -221,6 +241,149 @@ def test_index_enable_zeroes_at_index(hal):
     hal.step(1)
     assert hal.getp(P + "encoder.00.count") == 0
     assert hal.getp(P + "encoder.00.index-enable") == 0
+
+
+def test_step_dir_inputs_count_rising_edges(hal):
+    board(hal)
+    e = P + "encoder.00."
+    hal.setp(e + "sim-source", 1)
+    hal.setp(e + "position-scale", 4.0)
+    hal.setp(e + "sim-counts-per-rev", 0)
+    # phase-A is the step, phase-B the direction (high: down); the first
+    # read only takes the levels, so the step high there is not a count
+    step = [1, 0, 1, 1, 0, 1, 0, 1, 0, 0, 1, 0, 1]
+    dirn = [0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 0, 0]
+    tr = hal.run(len(step), inputs={e + "phase-A": step, e + "phase-B": dirn},
+                 record=[e + "count", e + "position"])
+    assert list(tr[e + "count"]) == [0, 0, 1, 1, 1, 2, 2, 1, 1, 1, 0, 0, 1]
+    assert tr[e + "position"][-1] == 0.25
+    # sim-position is ignored in this mode
+    hal.set({e + "sim-position": 50.0})
+    hal.step(1)
+    assert hal.getp(e + "count") == 1
+
+
+def test_quadrature_inputs_count_every_edge(hal):
+    board(hal)
+    e = P + "encoder.00."
+    hal.setp(e + "sim-source", 2)
+    hal.setp(e + "sim-counts-per-rev", 0)
+    # up: A leads B; then down; then a jump over two states (both inputs
+    # changed in one read), which has no direction and is not counted
+    ab = [(1, 0), (1, 1), (0, 1), (0, 0), (1, 0), (1, 0),
+          (0, 0), (0, 1), (1, 1), (0, 0), (1, 0)]
+    tr = hal.run(len(ab), inputs={e + "phase-A": [a for a, _ in ab],
+                                  e + "phase-B": [b for _, b in ab]},
+                 record=[e + "count"])
+    assert list(tr[e + "count"]) == [0, 1, 2, 3, 4, 4, 3, 2, 1, 1, 2]
+
+
+def test_source_change_keeps_count_and_bad_source_stands_still(hal):
+    board(hal)
+    e = P + "encoder.00."
+    hal.setp(e + "sim-counts-per-rev", 0)
+    hal.set({e + "sim-position": 7.0})
+    hal.step(1)
+    hal.set({e + "sim-position": 12.0})
+    hal.step(1)
+    assert hal.getp(e + "count") == 5
+    # to step/dir: the step already high is not a count, the next one is
+    hal.setp(e + "sim-source", 1)
+    hal.run(3, inputs={e + "phase-A": [1, 0, 1]})
+    assert hal.getp(e + "count") == 6
+    # back to the position: the count carries on from 6, not from 12 - 7
+    hal.setp(e + "sim-source", 0)
+    hal.set({e + "sim-position": 40.0})
+    hal.step(1)
+    assert hal.getp(e + "count") == 6
+    hal.set({e + "sim-position": 43.0})
+    hal.step(1)
+    assert hal.getp(e + "count") == 9
+    # an unknown source: nothing counts until it is valid again
+    hal.setp(e + "sim-source", 3)
+    hal.run(4, inputs={e + "sim-position": [50.0, 60.0, 70.0, 80.0],
+                       e + "phase-A": [0, 1, 0, 1]})
+    assert hal.getp(e + "count") == 9
+    hal.setp(e + "sim-source", 0)
+    hal.step(1)
+    hal.set({e + "sim-position": 81.0})
+    hal.step(1)
+    assert hal.getp(e + "count") == 10
+
+
+def stepgen_loopback(hal, step_type: int) -> str:
+    """A stepgen channel of step_type whose outputs drive the phase-A/B
+    inputs of encoder 00, both in a 25 us base thread (make-pulses, then
+    read; read uses floating point, so the thread has it); the slow parts
+    of stepgen in a 1 ms servo thread."""
+    outs = ("step", "dir") if step_type == 0 else ("phase-A", "phase-B")
+    e = P + "encoder.00."
+    hal.loadrt("stepgen", f"step_type={step_type}")
+    hal.loadrt("sim_io", num_encoder=1)
+    hal.newthread("base", 25_000)
+    hal.newthread("servo", 1_000_000)
+    hal.addf("stepgen.make-pulses", "base")
+    hal.addf(P + "read", "base")
+    hal.addf("stepgen.update-freq", "servo")
+    hal.addf("stepgen.capture-position", "servo")
+    hal.net("sa", "stepgen.0." + outs[0], e + "phase-A")
+    hal.net("sb", "stepgen.0." + outs[1], e + "phase-B")
+    hal.set({"stepgen.0.position-scale": 1000.0, "stepgen.0.maxvel": 10.0,
+             "stepgen.0.maxaccel": 200.0, "stepgen.0.enable": True,
+             e + "sim-source": 1 if step_type == 0 else 2,
+             e + "position-scale": 1000.0, e + "sim-counts-per-rev": 100})
+    return e
+
+
+@pytest.mark.parametrize("step_type", [0, 2])
+def test_stepgen_pulses_counted(hal, step_type):
+    e = stepgen_loopback(hal, step_type)
+    # forward, back past the start, forward again: 3 direction changes
+    cmd = np.repeat([0.3, -0.2, 0.05], [3000, 5000, 3000])
+    rec = ["stepgen.0.rawcounts", "stepgen.0.counts", e + "count",
+           e + "position", "sb"]
+    tr = hal.run(len(cmd), inputs={"stepgen.0.position-cmd": cmd},
+                 record=rec)
+    raw = tr["stepgen.0.rawcounts"]
+    assert raw.max() == 300 and raw.min() == -200
+    assert list(tr[e + "count"]) == list(raw)       # every base period
+    assert tr["stepgen.0.counts"][-1] == tr[e + "count"][-1] == 50
+    assert tr[e + "position"][-1] == pytest.approx(0.05)
+    assert list(tr[e + "position"]) == pytest.approx(list(raw / 1000.0))
+    if step_type == 0:
+        # dir was high (reverse) for the way down only
+        assert tr["sb"][np.diff(raw, prepend=0) < 0].all()
+        assert not tr["sb"][np.diff(raw, prepend=0) > 0].any()
+
+
+@pytest.mark.parametrize("step_type", [0, 2])
+def test_stepgen_index_every_counts_per_rev(hal, step_type):
+    e = stepgen_loopback(hal, step_type)
+    rec = ["stepgen.0.rawcounts", e + "count", e + "index-enable"]
+    hal.set({"stepgen.0.position-cmd": 0.35})
+    tr = hal.run(1000, record=rec)                 # 25 ms: under way
+    start = int(tr["stepgen.0.rawcounts"][-1])
+    assert 0 < start < 300
+    hal.set({e + "index-enable": 1})
+    tr = hal.run(6000, record=rec)
+    raw, count = tr["stepgen.0.rawcounts"], tr[e + "count"]
+    idx = (start // 100 + 1) * 100                 # next multiple up
+    hit = int(np.argmax(raw == idx))
+    assert raw[hit] == idx
+    assert list(tr[e + "index-enable"][:hit]) == [1] * hit
+    assert not tr[e + "index-enable"][hit:].any()
+    assert list(count[:hit]) == list(raw[:hit])
+    assert list(count[hit:]) == list(raw[hit:] - idx)
+    assert count[-1] == 350 - idx
+    # on the way down the first index met is the multiple below 350
+    hal.set({e + "index-enable": 1, "stepgen.0.position-cmd": -0.12})
+    tr = hal.run(8000, record=rec)
+    raw, count = tr["stepgen.0.rawcounts"], tr[e + "count"]
+    hit = int(np.argmax(raw == 300))
+    assert raw[hit] == 300 and tr[e + "index-enable"][hit - 1] == 1
+    assert not tr[e + "index-enable"][hit:].any()
+    assert list(count[hit:]) == list(raw[hit:] - 300)
+    assert count[-1] == -420
 
 
 def test_switches_with_hysteresis(hal):
