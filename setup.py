@@ -167,11 +167,18 @@ names = [e.name for e in components]
 if len(set(names)) != len(names):
     sys.exit("error: two sources in components/ make the same module")
 
+def python_drivers() -> list:
+    """The userspace drivers written in Python: drivers/<name>/ packages."""
+    return ["halsdk.drivers." + name for name in sorted(os.listdir("drivers"))
+            if os.path.isfile(os.path.join("drivers", name, "__init__.py"))]
+
+
 setup(
     packages=["halsdk", "halsdk.compat", "halsdk.demo", "halsdk.halcmd",
               "halsdk.components", "halsdk.gcode", "halsdk.machine",
               "halsdk.motion", "halsdk.tools", "halcompile",
-              "halsdk.demo.mill", "halsdk.driver", "halsdk.drivers"],
+              "halsdk.demo.mill", "halsdk.driver", "halsdk.drivers",
+              *python_drivers()],
     # the demo's machine is examples/mill, installed as package data
     package_dir={"halsdk.components": "components",
                  "halsdk.drivers": "drivers",

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import sys
 from collections.abc import Iterator
 
 import pytest
@@ -66,3 +67,13 @@ def component_path(tmp_path_factory: pytest.TempPathFactory) -> str:
         build_component(os.path.join(COMPONENTS, source), out_dir=folder)
     with on_halsdk_path(folder):
         yield folder
+
+
+@pytest.fixture
+def python_tools_first(monkeypatch: pytest.MonkeyPatch) -> str:
+    """Put the bin folder of the Python under test first on PATH, so that
+    ``loadusr PROGRAM`` runs this halsdk's program and not one of the same
+    name from elsewhere (the reference installs mb2hal, for one)."""
+    folder = os.path.dirname(sys.executable)
+    monkeypatch.setenv("PATH", folder + os.pathsep + os.environ["PATH"])
+    return folder

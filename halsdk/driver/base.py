@@ -37,7 +37,9 @@ class Driver:
     - :meth:`read` / :meth:`write` -- move values between device and pins.
 
     :meth:`start` creates the component ``<name>.<num>`` (component name
-    and pin prefix alike, so several devices can run at once) with the pins
+    and pin prefix alike, so several devices can run at once; pass
+    ``comp_name`` to name the component otherwise, for example after the
+    program, so that ``loadusr -W program`` waits for it) with the pins
     ``fault`` (bit), ``fault-code`` (u32, one of ``FAULT_*``),
     ``fault-count`` (u32, faults since start) and ``connected`` (bit), calls
     :meth:`setup` and marks the component ready.  A loop
@@ -46,9 +48,11 @@ class Driver:
 
     name = "driver"
 
-    def __init__(self, num: int = 0, instance: Optional[str] = None):
+    def __init__(self, num: int = 0, instance: Optional[str] = None,
+                 comp_name: Optional[str] = None):
         self.num = num
         self.prefix = f"{self.name}.{num}"
+        self.comp_name = comp_name or self.prefix
         self._instance = instance
         self.comp: Optional[Component] = None
         self._fault_text = ""
@@ -96,7 +100,7 @@ class Driver:
               ) -> Component:
         """Create the component, its fault pins, ``extra_pins`` (out pins
         as (name, type) pairs) and channels; ready it."""
-        self.comp = component(self.prefix, self.prefix, self._instance)
+        self.comp = component(self.comp_name, self.prefix, self._instance)
         try:
             for pin, type_ in (("fault", "bit"), ("fault-code", "u32"),
                                ("fault-count", "u32"), ("connected", "bit"),
