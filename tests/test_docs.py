@@ -21,11 +21,11 @@ from halsdk.build import build_component
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 DOCS = os.path.join(ROOT, "docs")
-PAGES = ["index", "concepts", "tutorial", "components", "halcmd",
-         "halcompile", "python-api", "cython-components", "c-components",
-         "motion", "running", "machine", "tooltable", "gcode", "drivers",
-         "driver-sim-io", "homing", "kinematics", "design", "compat",
-         "benchmarks"]
+PAGES = ["index", "concepts", "tutorial", "components", "halcmd", "halcompile",
+         "python-api", "cython-components", "c-components", "motion",
+         "running", "machine", "tooltable", "gcode", "drivers",
+         "driver-sim-io", "driver-mb2hal", "homing", "kinematics", "design",
+         "compat", "benchmarks"]
 
 
 @pytest.fixture(scope="module")

@@ -1,0 +1,63 @@
+"""``mb2hal config=FILE.ini`` -- the userspace Modbus component."""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import sys
+from collections.abc import Sequence
+from typing import Optional
+
+from halsdk.drivers.mb2hal.config import ConfigError, load_config
+from halsdk.drivers.mb2hal.engine import Mb2hal
+
+from halsdk.errors import HalError
+
+LEVELS = {0: logging.CRITICAL + 1, 1: logging.WARNING, 2: logging.INFO,
+          3: logging.DEBUG, 4: logging.DEBUG}
+
+
+def _args(argv: Sequence[str]) -> argparse.Namespace:
+    parser = argparse.ArgumentParser(
+        prog="mb2hal", description="Modbus (TCP/RTU) to HAL component.")
+    parser.add_argument("-n", "--name", help="component name (overrides "
+                        "HAL_MODULE_NAME)")
+    parser.add_argument("setting", nargs="*", help="config=FILE.ini")
+    args = parser.parse_args(argv)
+    args.config = None
+    for item in args.setting:
+        key, sep, value = item.partition("=")
+        if key != "config" or not sep or not value:
+            parser.error(f"unknown argument '{item}' (use config=FILE.ini)")
+        args.config = value
+    if args.config is None:
+        parser.error("missing config=FILE.ini")
+    return args
+
+
+def main(argv: Optional[Sequence[str]] = None) -> int:
+    args = _args(sys.argv[1:] if argv is None else argv)
+    logging.basicConfig(format="mb2hal: %(message)s", stream=sys.stderr)
+    try:
+        config = load_config(args.config)
+    except ConfigError as exc:
+        print(f"mb2hal: {exc}", file=sys.stderr)
+        return 1
+    level = max([config.init_debug] + [t.debug for t in config.transactions])
+    logging.getLogger("halsdk.mb2hal").setLevel(LEVELS[level])
+    if level >= 4:
+        logging.getLogger("pymodbus").setLevel(logging.DEBUG)
+    if config.init_debug >= 2:
+        logging.getLogger("halsdk.mb2hal").info(
+            "%s: %d transaction(s) on %d link(s)", config.path,
+            len(config.transactions), len(config.links))
+    try:
+        Mb2hal(config, args.name).run()
+    except HalError as exc:
+        print(f"mb2hal: cannot create the component: {exc}", file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,111 @@
+"""A small Modbus TCP (or RTU) server on loopback for trying mb2hal.
+
+    python simulator.py [--port 5020]           # TCP on 127.0.0.1
+    python simulator.py --serial /dev/pts/N     # RTU on a serial port
+
+Every table (coils, discrete inputs, holding and input registers) holds
+addresses 0..199 (input registers 0..2 hold 100, 200, 300).
+:class:`ServerThread` runs the same server in a background thread (used
+by the tests and the benchmark).
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import logging
+import threading
+import time
+from typing import Any, Optional
+
+SIZE = 200
+
+
+def make_context(size: int = SIZE, inputs: Optional[list[int]] = None,
+                 discrete: Optional[list[bool]] = None) -> Any:
+    """A single-device server context with ``size`` elements per table,
+    protocol addresses 0..size-1."""
+    from pymodbus.datastore import (
+        ModbusDeviceContext,
+        ModbusSequentialDataBlock,
+        ModbusServerContext,
+    )
+    logging.getLogger("pymodbus").setLevel(logging.CRITICAL)
+    ir = (inputs or []) + [0] * (size - len(inputs or []))
+    di = (discrete or []) + [False] * (size - len(discrete or []))
+    device = ModbusDeviceContext(
+        co=ModbusSequentialDataBlock(1, [False] * size),
+        di=ModbusSequentialDataBlock(1, di),
+        hr=ModbusSequentialDataBlock(1, [0] * size),
+        ir=ModbusSequentialDataBlock(1, ir))
+    return ModbusServerContext(devices=device, single=True)
+
+
+class ServerThread:
+    """A pymodbus server served from its own event loop thread."""
+
+    def __init__(self, port: int = 0, serial: str = "",
+                 context: Any = None, baudrate: int = 115200):
+        self.port = port
+        self.serial = serial
+        self.baudrate = baudrate
+        self.context = context if context is not None else make_context()
+        self.loop = asyncio.new_event_loop()
+        self.server: Any = None
+        self.thread = threading.Thread(target=self.loop.run_forever,
+                                       daemon=True, name="modbus-server")
+
+    async def _create(self) -> None:
+        from pymodbus.server import ModbusSerialServer, ModbusTcpServer
+        if self.serial:
+            self.server = ModbusSerialServer(
+                self.context, port=self.serial, baudrate=self.baudrate,
+                stopbits=1, bytesize=8, parity="N", timeout=1)
+        else:
+            self.server = ModbusTcpServer(
+                self.context, address=("127.0.0.1", self.port))
+        await self.server.serve_forever(background=True)
+        if not self.serial and not self.port:
+            sock = self.server.transport.sockets[0]
+            self.port = sock.getsockname()[1]
+
+    def start(self, timeout: float = 5.0) -> ServerThread:
+        self.thread.start()
+        fut = asyncio.run_coroutine_threadsafe(self._create(), self.loop)
+        fut.result(timeout)
+        return self
+
+    def stop(self, timeout: float = 5.0) -> None:
+        if self.server is not None:
+            fut = asyncio.run_coroutine_threadsafe(self.server.shutdown(),
+                                                   self.loop)
+            try:
+                fut.result(timeout)
+            except Exception:       # already closed
+                pass
+        self.loop.call_soon_threadsafe(self.loop.stop)
+        self.thread.join(timeout)
+        if not self.thread.is_alive():
+            self.loop.close()
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--port", type=int, default=5020)
+    parser.add_argument("--serial", default="")
+    args = parser.parse_args()
+    context = make_context(inputs=[100, 200, 300], discrete=[True])
+    server = ServerThread(args.port, args.serial, context).start()
+    where = args.serial or f"127.0.0.1:{server.port}"
+    print(f"modbus simulator on {where}; Ctrl-C stops it", flush=True)
+    try:
+        while True:
+            time.sleep(1)
+    except KeyboardInterrupt:
+        pass
+    finally:
+        server.stop()
+
+
+if __name__ == "__main__":
+    main()
