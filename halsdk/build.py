@@ -92,6 +92,12 @@ def _digest(paths: Sequence[str], extra: Sequence[str],
     for p in (C_ENTRY, os.path.join(PACKAGE_DIR, "hal.pxd")):
         with open(p, "rb") as f:
             h.update(f.read())
+    # the realtime driver helpers that a module may cimport
+    rt_dir = os.path.join(PACKAGE_DIR, "driver")
+    for name in sorted(os.listdir(rt_dir)):
+        if name.endswith(".pxd"):
+            with open(os.path.join(rt_dir, name), "rb") as f:
+                h.update(name.encode() + f.read())
     h.update(sys.version.encode())
     h.update("\0".join(extra).encode())
     return h.hexdigest()[:24]

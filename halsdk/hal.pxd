@@ -31,7 +31,9 @@ cdef extern from "hal.h" nogil:
     ctypedef enum hal_param_dir_t:
         HAL_RO, HAL_RW
 
-    ctypedef void (*hal_funct_t)(void *arg, long period) noexcept nogil
+    # a realtime function; the C name is the API header's typedef
+    ctypedef void (*hal_funct_t "halsdk_funct_t")(void *arg, long period) \
+        noexcept nogil
 
     int hal_init(const char *name)
     int hal_exit(int comp_id)
