@@ -174,6 +174,13 @@ def test_encoder_scale_velocity_reset(hal, rig):
     hal.setp("fakedev.0.encoder.00.reset", True)
     step(loop, clock)
     assert hal.getp("fakedev.0.encoder.00.count") == 0
+    # the counter stood still: a reset is no movement
+    assert hal.getp("fakedev.0.encoder.00.velocity") == 0.0
+    hal.setp("fakedev.0.encoder.00.reset", False)
+    board.count = 1040
+    step(loop, clock)
+    assert hal.getp("fakedev.0.encoder.00.count") == -10
+    assert hal.getp("fakedev.0.encoder.00.velocity") == pytest.approx(-10.0)
 
 
 def test_timing_statistics(hal, rig):

@@ -141,18 +141,21 @@ class Encoder(Channel):
         self._pin("reset", "bit", "in")
         self._param("position-scale", "float", 1.0)
         self._zero = 0
-        self._last: float | None = None
+        self._last: int | None = None
 
     def update(self, raw_count: int, dt: float) -> None:
         """Publish a raw hardware count read ``dt`` seconds after the
-        previous one; ``reset`` makes the current count the new zero."""
+        previous one; ``reset`` makes the current count the new zero.
+        ``velocity`` is the counts moved over ``dt`` (0 on the first
+        update), so a reset does not make it jump."""
         if self["reset"]:
             self._zero = raw_count
         count = int(raw_count - self._zero)
         scale = self["position-scale"] or 1.0
-        position = count / scale
-        if self._last is not None and dt > 0:
-            self["velocity"] = (position - self._last) / dt
-        self._last = position
+        if self._last is None:
+            self["velocity"] = 0.0
+        elif dt > 0:
+            self["velocity"] = (raw_count - self._last) / scale / dt
+        self._last = raw_count
         self["count"] = count
-        self["position"] = position
+        self["position"] = count / scale
