@@ -232,7 +232,7 @@ def test_disappear_backoff_grows_then_resets(hal, rig, caplog):
     assert not hal.getp("fakedev.0.fault")
     assert hal.getp("fakedev.0.fault-code") == FAULT_NONE
     assert hal.getp("fakedev.0.connected")
-    assert loop.delay == pytest.approx(0.1)       # back-off reset
+    assert loop.retry.delay == pytest.approx(0.1)  # back-off reset
     assert hal.getp("fakedev.0.fault-count") == 2
 
 

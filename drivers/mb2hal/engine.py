@@ -13,6 +13,7 @@ from halsdk.drivers.mb2hal.client import LinkDown, ModbusLink, Refused
 from halsdk.drivers.mb2hal.config import VERSION_1_1, Config, Link, Transaction
 
 from halsdk.component import Component, component
+from halsdk.driver.backoff import Backoff
 
 log = logging.getLogger("halsdk.mb2hal")
 
@@ -100,10 +101,7 @@ class LinkWorker:
         self.runners = runners
         self.slowdown = slowdown
         self.stop = stop
-        self.backoff = backoff
-        self.backoff_max = backoff_max
-        self.delay = backoff
-        self.next_attempt = 0.0
+        self.retry = Backoff(backoff, backoff_max)
         self.conn = factory(link)
         self.down_text = ""
         self.debug = max(r.tx.debug for r in runners)
@@ -130,11 +128,10 @@ class LinkWorker:
 
     def _down(self, text: str) -> None:
         self.conn.close()
+        wait = self.retry.failed(time.monotonic())
         if text != self.down_text and self.debug >= DEBUG_ERR:
-            log.error("%s (retry in %.3g s)", text, self.delay)
+            log.error("%s (retry in %.3g s)", text, wait)
         self.down_text = text
-        self.next_attempt = time.monotonic() + self.delay
-        self.delay = min(self.delay * 2, self.backoff_max)
 
     # -- one transaction -------------------------------------------------
     def transact(self, runner: TxRunner) -> None:
@@ -152,7 +149,7 @@ class LinkWorker:
         if not tx.is_write:
             runner.publish(result)
         runner.ok_count += 1
-        self.delay = self.backoff
+        self.retry.succeeded()
         if runner.failing and tx.debug >= DEBUG_ERR:
             log.warning("%s: transaction %s: ok again", tx.line, tx.name)
         elif tx.debug >= DEBUG_DEBUG:
@@ -186,7 +183,7 @@ class LinkWorker:
             if now < runner.next_due:
                 continue
             if not self.conn.is_open:
-                if now < self.next_attempt or not self._connect(runner):
+                if not self.retry.ready(now) or not self._connect(runner):
                     break
             runner.next_due = now + runner.period
             self.transact(runner)
@@ -201,7 +198,7 @@ class LinkWorker:
     def _idle(self) -> None:
         wake = min(r.next_due for r in self.runners)
         if not self.conn.is_open:
-            wake = max(wake, self.next_attempt)
+            wake = max(wake, self.retry.next_attempt)
         wait = wake - time.monotonic()
         self.stop.wait(min(max(wait, 0.0005), 0.1))
 

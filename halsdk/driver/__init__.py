@@ -1,6 +1,7 @@
 """SDK for userspace HAL drivers written in Python: the :class:`Driver`
 base class, canonical channel helpers and the :class:`IOLoop`."""
 
+from halsdk.driver.backoff import Backoff
 from halsdk.driver.base import (
                                 FAULT_NONE,
                                 FAULT_OPEN,
@@ -12,6 +13,6 @@ from halsdk.driver.base import (
 from halsdk.driver.canonical import AdcIn, DacOut, DigIn, DigOut, Encoder
 from halsdk.driver.loop import STAT_PINS, IOLoop
 
-__all__ = ["Driver", "DriverError", "IOLoop", "STAT_PINS", "DigIn", "DigOut",
+__all__ = ["Backoff", "Driver", "DriverError", "IOLoop", "STAT_PINS", "DigIn", "DigOut",
            "AdcIn", "DacOut", "Encoder", "FAULT_NONE", "FAULT_OPEN",
            "FAULT_READ", "FAULT_WRITE"]

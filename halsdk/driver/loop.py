@@ -8,6 +8,7 @@ import threading
 import time
 from typing import Callable, Optional
 
+from halsdk.driver.backoff import Backoff
 from halsdk.driver.base import (
     FAULT_OPEN,
     FAULT_READ,
@@ -45,19 +46,15 @@ class IOLoop:
                  backoff: float = 0.1, backoff_max: float = 5.0,
                  clock: Callable[[], float] = time.monotonic,
                  sleep: Optional[Callable[[float], None]] = None):
-        if period <= 0 or backoff <= 0 or backoff_max < backoff:
-            raise ValueError("period and backoff must be > 0 and "
-                             "backoff_max >= backoff")
+        if period <= 0:
+            raise ValueError("period must be > 0")
         self.driver = driver
         self.period = period
-        self.backoff = backoff
-        self.backoff_max = backoff_max
+        self.retry = Backoff(backoff, backoff_max)
         self.clock = clock
         self._stop = threading.Event()
         self.sleep = sleep or self._stop.wait
         self.connected = False
-        self.delay = backoff          # next back-off delay
-        self.next_attempt = 0.0       # clock time of the next open attempt
         self._last_start: Optional[float] = None
         self._thread: Optional[threading.Thread] = None
 
@@ -81,7 +78,7 @@ class IOLoop:
                 comp["max-period"] = comp["period"]
         self._last_start = now
         if not self.connected:
-            if now < self.next_attempt:
+            if not self.retry.ready(now):
                 return
             try:
                 d.open()
@@ -103,7 +100,7 @@ class IOLoop:
             return
         comp["read-time"] = t1 - t0
         comp["write-time"] = t2 - t1
-        self.delay = self.backoff
+        self.retry.succeeded()
         d.clear_fault()
 
     def _failed(self, code: int, exc: BaseException, now: float) -> None:
@@ -113,9 +110,8 @@ class IOLoop:
             d.safe_close()
             self.connected = False
             d.comp["connected"] = False
-        self.next_attempt = now + self.delay
-        log.info("%s: reconnect in %.3g s", d.prefix, self.delay)
-        self.delay = min(self.delay * 2, self.backoff_max)
+        wait = self.retry.failed(now)
+        log.info("%s: reconnect in %.3g s", d.prefix, wait)
 
     # -- running -----------------------------------------------------------
     def run(self, handle_signals: bool = True) -> None:
