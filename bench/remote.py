@@ -18,8 +18,9 @@ batch          one message per cycle holding all 1,000 values (periodic
                publish with a period shorter than a cycle)
 =============  ===========================================================
 
-Modbus: ``bench(seconds)`` of ``bench/remote_modbus.py`` (transactions per
-second against a local simulator), when that file is there.
+Modbus: ``bench/remote_modbus.py``: transactions per second of our engine
+against a local simulator, then our mb2hal program and the reference's
+(when LinuxCNC is installed) under halrun, counted at the server.
 
 Run: ``python bench/remote.py [--seconds 3] [--pins 1000]``.
 """
@@ -143,18 +144,12 @@ def mqtt_bench(pins: int, seconds: float) -> None:
                   f"{published:>12,.0f}")
 
 
-def modbus_bench(seconds: float) -> None:
+def modbus_bench(seconds: float, reference: bool) -> None:
     sys.path.insert(0, HERE)
-    try:
-        from remote_modbus import bench  # type: ignore[import-not-found]
-    except ImportError as exc:
-        print(f"\nModbus: not measured (bench/remote_modbus.py: {exc})")
-        return
+    from remote_modbus import bench, compare  # type: ignore[import-not-found]
     print("\nModbus (bench/remote_modbus.py):")
-    result = bench(seconds)
-    for key, value in result.items():
-        shown = f"{value:,.1f}" if isinstance(value, float) else value
-        print(f"  {key}: {shown}")
+    bench(seconds)
+    compare(seconds, reference)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -162,10 +157,12 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--seconds", type=float, default=3.0)
     p.add_argument("--pins", type=int, default=1000)
     p.add_argument("--no-modbus", action="store_true")
+    p.add_argument("--no-reference", action="store_true",
+                   help="do not run the reference's mb2hal")
     args = p.parse_args(argv)
     mqtt_bench(args.pins, args.seconds)
     if not args.no_modbus:
-        modbus_bench(args.seconds)
+        modbus_bench(args.seconds, not args.no_reference)
     return 0
 
 

@@ -1,20 +1,33 @@
-"""Transactions per second of the mb2hal engine against a local pymodbus
-TCP server on loopback (read holding registers, write registers, write
-coils; no rate limit).
+"""Transactions per second of mb2hal against a local pymodbus TCP server
+on loopback (read holding registers, write registers, write coils; no
+rate limit).
 
-    python bench/remote_modbus.py [seconds]
+``bench()`` runs our engine in this process. ``compare()`` runs the same
+INI file as a program under halrun (``loadusr -W mb2hal config=...``),
+ours and -- when LinuxCNC is installed -- the reference's, one after the
+other, and counts the requests at the server, so both are measured the
+same way in one run.
+
+    python bench/remote_modbus.py [seconds] [--no-reference]
 """
 
 from __future__ import annotations
 
 import importlib.util
 import os
+import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
+REFERENCE_MB2HAL = "/usr/bin/mb2hal"
+REFERENCE_TOOL = os.environ.get(
+    "HALSDK_REFERENCE_TOOL",
+    str(ROOT.parent / "shared" / "tools" / "reference"))
+#: one reference HAL at a time on a machine (the tests' lock too)
+LOCK = "/tmp/halsdk-reference.lock"
 
 INI = """[MB2HAL_INIT]
 INIT_DEBUG=0
@@ -89,5 +102,81 @@ def bench(seconds: float = 3.0) -> dict:
     return result
 
 
+def _program_rate(reference: bool, seconds: float) -> float:
+    """Requests per second that halrun + mb2hal make, counted at the
+    server."""
+    sim = _simulator()
+    count = [0]
+
+    def on_request() -> None:
+        count[0] += 1
+
+    server = sim.ServerThread(on_request=on_request).start()
+    folder = tempfile.mkdtemp(prefix="halsdk-bench-mb-")
+    os.chmod(folder, 0o755)
+    try:
+        ini = Path(folder) / "bench.ini"
+        ini.write_text(INI.format(port=server.port))
+        hal = Path(folder) / "bench.hal"
+        hal.write_text("loadusr -Wn mbbench mb2hal config=bench.ini\n"
+                       f"loadusr -w sleep {seconds + 3:.1f}\n")
+        for f in (ini, hal):
+            os.chmod(f, 0o644)
+        env = dict(os.environ)
+        if reference:
+            env["PATH"] = "/usr/sbin:/usr/bin:/sbin:/bin"
+            cmd = ["flock", LOCK, "timeout", "120", REFERENCE_TOOL,
+                   "halrun", "-f", "bench.hal"]
+        else:
+            bindir = os.path.dirname(sys.executable)
+            env["PATH"] = bindir + os.pathsep + env.get("PATH", "")
+            env["HALSDK_INSTANCE"] = f"mbbench-{os.getpid()}"
+            cmd = [os.path.join(bindir, "halrun"), "-f", "bench.hal"]
+        proc = subprocess.Popen(cmd, cwd=folder, env=env,
+                                stdin=subprocess.DEVNULL,
+                                stdout=subprocess.DEVNULL,
+                                stderr=subprocess.DEVNULL,
+                                start_new_session=True)
+        try:
+            deadline = time.monotonic() + 60
+            while count[0] == 0:
+                if proc.poll() is not None or time.monotonic() > deadline:
+                    raise RuntimeError("mb2hal sent no request")
+                time.sleep(0.01)
+            time.sleep(0.5)                      # connected, warm
+            n0, t0 = count[0], time.monotonic()
+            time.sleep(seconds)
+            n1, t1 = count[0], time.monotonic()
+            proc.wait(timeout=seconds + 60)
+        finally:
+            if proc.poll() is None:
+                os.killpg(proc.pid, 15)
+                proc.wait(timeout=10)
+    finally:
+        server.stop()
+        for name in os.listdir(folder):
+            os.unlink(os.path.join(folder, name))
+        os.rmdir(folder)
+    return (n1 - n0) / (t1 - t0)
+
+
+def compare(seconds: float = 3.0, reference: bool = True) -> dict:
+    """Ours and the reference's mb2hal program, side by side."""
+    ours = _program_rate(False, seconds)
+    ref = None
+    if reference and os.path.exists(REFERENCE_MB2HAL) and \
+            os.access(REFERENCE_TOOL, os.X_OK):
+        ref = _program_rate(True, seconds)
+    print(f"mb2hal program under halrun, requests/s at the server: "
+          f"ours {ours:.0f}, reference "
+          + (f"{ref:.0f}, ratio ours/reference {ours / ref:.2f}"
+             if ref else "not installed"))
+    return {"ours_tx_per_s": round(ours, 1),
+            "reference_tx_per_s": None if ref is None else round(ref, 1)}
+
+
 if __name__ == "__main__":
-    bench(float(sys.argv[1]) if len(sys.argv) > 1 else 3.0)
+    args = [a for a in sys.argv[1:] if not a.startswith("--")]
+    secs = float(args[0]) if args else 3.0
+    bench(secs)
+    compare(secs, reference="--no-reference" not in sys.argv)

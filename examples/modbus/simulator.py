@@ -6,7 +6,8 @@
 Every table (coils, discrete inputs, holding and input registers) holds
 addresses 0..199 (input registers 0..2 hold 100, 200, 300).
 :class:`ServerThread` runs the same server in a background thread (used
-by the tests and the benchmark).
+by the tests and the benchmark; ``on_request`` is called for every
+request the server receives).
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ import asyncio
 import logging
 import threading
 import time
-from typing import Any, Optional
+from typing import Any, Callable, Optional
 
 SIZE = 200
 
@@ -45,8 +46,10 @@ class ServerThread:
     """A pymodbus server served from its own event loop thread."""
 
     def __init__(self, port: int = 0, serial: str = "",
-                 context: Any = None, baudrate: int = 115200):
+                 context: Any = None, baudrate: int = 115200,
+                 on_request: Optional[Callable[[], None]] = None):
         self.port = port
+        self.on_request = on_request
         self.serial = serial
         self.baudrate = baudrate
         self.context = context if context is not None else make_context()
@@ -55,15 +58,21 @@ class ServerThread:
         self.thread = threading.Thread(target=self.loop.run_forever,
                                        daemon=True, name="modbus-server")
 
+    def _trace(self, sending: bool, pdu: Any) -> Any:
+        if not sending and self.on_request is not None:
+            self.on_request()
+        return pdu
+
     async def _create(self) -> None:
         from pymodbus.server import ModbusSerialServer, ModbusTcpServer
+        trace = {"trace_pdu": self._trace} if self.on_request else {}
         if self.serial:
             self.server = ModbusSerialServer(
                 self.context, port=self.serial, baudrate=self.baudrate,
-                stopbits=1, bytesize=8, parity="N", timeout=1)
+                stopbits=1, bytesize=8, parity="N", timeout=1, **trace)
         else:
             self.server = ModbusTcpServer(
-                self.context, address=("127.0.0.1", self.port))
+                self.context, address=("127.0.0.1", self.port), **trace)
         await self.server.serve_forever(background=True)
         if not self.serial and not self.port:
             sock = self.server.transport.sockets[0]
