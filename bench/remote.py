@@ -33,10 +33,9 @@ import subprocess
 import sys
 import time
 
+import halsdk
 from halsdk.drivers.mqtt import Bridge, BridgeConfig
 from halsdk.drivers.mqtt.broker import Mosquitto
-
-import halsdk
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 

@@ -64,9 +64,8 @@ def _simulator():
 
 def bench(seconds: float = 3.0) -> dict:
     """Run the engine for ``seconds``; return transactions per second."""
-    from halsdk.drivers.mb2hal import Mb2hal, load_config
-
     import halsdk
+    from halsdk.drivers.mb2hal import Mb2hal, load_config
     sim = _simulator()
     server = sim.ServerThread().start()
     hal = None

@@ -15,6 +15,8 @@ import time
 import can
 import cantools
 import pytest
+
+from halsdk.driver import FAULT_OPEN, FAULT_READ, IOLoop
 from halsdk.drivers.candbc import (
     CanDbcDriver,
     ConfigError,
@@ -22,8 +24,6 @@ from halsdk.drivers.candbc import (
     parse_args,
 )
 from halsdk.drivers.candbc.dbc import find_package_dbc
-
-from halsdk.driver import FAULT_OPEN, FAULT_READ, IOLoop
 from halsdk.types import Direction, HalType
 
 HERE = os.path.dirname(os.path.abspath(__file__))

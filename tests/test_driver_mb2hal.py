@@ -16,6 +16,7 @@ import tty
 from pathlib import Path
 
 import pytest
+
 from halsdk.drivers.mb2hal import ConfigError, Mb2hal, load_config
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -16,13 +16,13 @@ from typing import Any, Callable
 
 import paho.mqtt.client as mqtt
 import pytest
+from paho.mqtt.enums import CallbackAPIVersion
+
+import halsdk
 from halsdk.drivers.mqtt import Bridge, BridgeConfig, ConfigError
 from halsdk.drivers.mqtt.bridge import FAULT_CONNECT, FAULT_REFUSED
 from halsdk.drivers.mqtt.broker import Mosquitto, find_mosquitto, free_port
 from halsdk.drivers.mqtt.config import Subscription, parse_args
-from paho.mqtt.enums import CallbackAPIVersion
-
-import halsdk
 
 PREFIX = "t/bridge"
 

@@ -12,10 +12,10 @@ import time
 from pathlib import Path
 
 import pytest
-from halsdk.drivers.whb04b import BUTTON_NAMES, FakeBackend, Whb04bDriver
-from halsdk.drivers.whb04b.fake import ScriptError, load_script, parse_script
 
 from halsdk.driver import FAULT_NONE, FAULT_OPEN, FAULT_READ, IOLoop
+from halsdk.drivers.whb04b import BUTTON_NAMES, FakeBackend, Whb04bDriver
+from halsdk.drivers.whb04b.fake import ScriptError, load_script, parse_script
 from halsdk.types import Direction, HalType
 
 DATA = Path(__file__).parent / "data" / "whb04b"

@@ -10,10 +10,10 @@ import time
 
 import numpy as np
 import pytest
-from halsdk.components._instances import instance_names, split_names
 
 import halsdk
 from halsdk import _core
+from halsdk.components._instances import instance_names, split_names
 
 GATES = {
     "and2": lambda a, b: a and b,

@@ -10,7 +10,6 @@ from typing import Optional
 
 from halsdk.drivers.mb2hal.config import ConfigError, load_config
 from halsdk.drivers.mb2hal.engine import Mb2hal
-
 from halsdk.errors import HalError
 
 LEVELS = {0: logging.CRITICAL + 1, 1: logging.WARNING, 2: logging.INFO,

@@ -9,11 +9,10 @@ import threading
 import time
 from typing import Callable, Optional
 
-from halsdk.drivers.mb2hal.client import LinkDown, ModbusLink, Refused
-from halsdk.drivers.mb2hal.config import VERSION_1_1, Config, Link, Transaction
-
 from halsdk.component import Component, component
 from halsdk.driver.backoff import Backoff
+from halsdk.drivers.mb2hal.client import LinkDown, ModbusLink, Refused
+from halsdk.drivers.mb2hal.config import VERSION_1_1, Config, Link, Transaction
 
 log = logging.getLogger("halsdk.mb2hal")
 

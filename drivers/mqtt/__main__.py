@@ -10,7 +10,6 @@ from typing import Optional
 
 from halsdk.drivers.mqtt.bridge import Bridge
 from halsdk.drivers.mqtt.config import ConfigError, parse_args
-
 from halsdk.errors import HalError
 
 

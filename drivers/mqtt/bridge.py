@@ -11,12 +11,11 @@ import time
 from dataclasses import dataclass
 from typing import Any, Callable, Optional
 
+from halsdk import _core
+from halsdk.component import Component, component
 from halsdk.drivers.mqtt import payload
 from halsdk.drivers.mqtt.client import Link
 from halsdk.drivers.mqtt.config import BridgeConfig, ConfigError, Subscription
-
-from halsdk import _core
-from halsdk.component import Component, component
 from halsdk.errors import HalError
 
 log = logging.getLogger("halsdk.driver.mqtt")

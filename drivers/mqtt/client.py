@@ -9,8 +9,9 @@ import threading
 from typing import Any, Optional
 
 import paho.mqtt.client as mqtt
-from halsdk.drivers.mqtt.config import BridgeConfig, ConfigError
 from paho.mqtt.enums import CallbackAPIVersion
+
+from halsdk.drivers.mqtt.config import BridgeConfig, ConfigError
 
 #: events: ("up",), ("refused", words), ("fail", words), ("lost", words),
 #: ("msg", topic, payload)

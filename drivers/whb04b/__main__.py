@@ -9,11 +9,10 @@ from collections.abc import Sequence
 from importlib import resources
 from typing import Optional
 
+from halsdk.driver import IOLoop
 from halsdk.drivers.whb04b.driver import Whb04bDriver
 from halsdk.drivers.whb04b.fake import FakeBackend, ScriptError, load_script
 from halsdk.drivers.whb04b.protocol import PRODUCT_ID
-
-from halsdk.driver import IOLoop
 
 DEMO = "demo"
 

@@ -9,6 +9,8 @@ from typing import Any, Callable, Optional
 
 import usb.core
 import usb.util
+
+from halsdk.driver import Driver, DriverError
 from halsdk.drivers.whb04b.protocol import (
     AXIS_NAMES,
     BUTTON_NAMES,
@@ -29,8 +31,6 @@ from halsdk.drivers.whb04b.protocol import (
     encode_display,
     parse_report,
 )
-
-from halsdk.driver import Driver, DriverError
 
 log = logging.getLogger("halsdk.driver")
 
