@@ -24,9 +24,9 @@ DOCS = os.path.join(ROOT, "docs")
 PAGES = ["index", "concepts", "tutorial", "components", "halcmd", "halcompile",
          "python-api", "cython-components", "c-components", "motion",
          "running", "machine", "tooltable", "gcode", "drivers",
-         "driver-realtime", "driver-sim-io", "driver-whb04b", "driver-mqtt",
-         "driver-candbc", "driver-mb2hal", "homing", "kinematics", "design",
-         "compat", "benchmarks"]
+         "driver-realtime", "driver-sim-io", "driver-cia402", "driver-whb04b",
+         "driver-mqtt", "driver-candbc", "driver-mb2hal", "homing",
+         "kinematics", "design", "compat", "benchmarks"]
 
 
 @pytest.fixture(scope="module")

@@ -1,0 +1,146 @@
+"""The bus: one HAL component (``cia402`` by default) for all drives, the
+CAN connection, SYNC, and the count of unknown and malformed frames."""
+
+from __future__ import annotations
+
+import logging
+import threading
+from typing import Optional
+
+import can
+import canopen
+
+from halsdk.driver import Driver
+from halsdk.drivers.cia402.config import BusConfig
+from halsdk.drivers.cia402.drive import DriveLink
+from halsdk.drivers.cia402.sim import SimBus, SimDrive
+
+log = logging.getLogger("halsdk.drivers.cia402")
+
+#: function codes (COB-ID & 0x780) without a node id
+_BROADCAST = {0x000, 0x080, 0x100}
+
+
+class _FrameWatch(can.Listener):
+    """Counts frames of unknown nodes and malformed frames."""
+
+    def __init__(self, driver: Cia402Driver):
+        self.driver = driver
+
+    def on_message_received(self, msg: can.Message) -> None:
+        d = self.driver
+        if msg.is_error_frame or msg.is_remote_frame:
+            d.count_malformed(msg.arbitration_id, "error or remote frame")
+            return
+        cob = msg.arbitration_id
+        if msg.is_extended_id:
+            d.count_unknown(cob, "extended (29-bit) identifier")
+            return
+        if cob in _BROADCAST or cob in d.own_ids:
+            if cob == 0 and len(msg.data) != 2:
+                d.count_malformed(cob, f"NMT of {len(msg.data)} bytes")
+            return
+        if cob not in d.known_ids:
+            d.count_unknown(cob, f"node {cob & 0x7F}" if cob & 0x7F
+                            else "no node")
+
+    def stop(self) -> None:
+        """Nothing to release."""
+
+
+class Cia402Driver(Driver):
+    """All drives of one CAN bus, as component ``name``."""
+
+    name = "cia402"
+
+    def __init__(self, config: BusConfig, comp_name: str = "cia402",
+                 simulate: bool = False, instance: Optional[str] = None):
+        super().__init__(0, instance, comp_name=comp_name)
+        self.prefix = comp_name       # pins <comp_name>.<pin>
+        self.config = config
+        self.simulate = simulate or config.simulate
+        self.drives: list[DriveLink] = []
+        self.network: Optional[canopen.Network] = None
+        self.sim: Optional[SimBus] = None
+        self.known_ids: set[int] = set()
+        self.own_ids: set[int] = set()
+        self._count_lock = threading.Lock()
+        self._unknown = 0
+        self._malformed = 0
+        self._logged_frames: set[tuple[str, int]] = set()
+
+    # -- pins ---------------------------------------------------------------
+    def setup(self) -> None:
+        comp = self.comp
+        comp.newpin("unknown-frames", "u32", "out")
+        comp.newpin("malformed-frames", "u32", "out")
+        for cfg in self.config.drives:
+            link = DriveLink(cfg, comp, self.prefix, self.count_malformed,
+                             self.config.sdo_timeout)
+            self.drives.append(link)
+            self.known_ids |= link.known_cob_ids()
+            nid = cfg.node_id
+            self.own_ids |= {0x600 + nid, *(cfg.rpdo_cob(n) for n in
+                                            cfg.rpdo)}
+
+    # -- frame statistics (notifier thread) -------------------------------
+    def count_unknown(self, cob: int, what: str) -> None:
+        with self._count_lock:
+            self._unknown += 1
+            first = ("unknown", cob & 0x7F) not in self._logged_frames
+            self._logged_frames.add(("unknown", cob & 0x7F))
+        if first:
+            log.warning("%s: ignoring frames of unknown origin: COB-ID "
+                        "0x%03X (%s)", self.prefix, cob, what)
+
+    def count_malformed(self, cob: int, what: str) -> None:
+        with self._count_lock:
+            self._malformed += 1
+            first = ("malformed", cob) not in self._logged_frames
+            self._logged_frames.add(("malformed", cob))
+        if first:
+            log.warning("%s: ignoring malformed frame: COB-ID 0x%03X (%s)",
+                        self.prefix, cob, what)
+
+    # -- device -------------------------------------------------------------
+    def open(self) -> None:
+        cfg = self.config
+        interface = "virtual" if self.simulate else cfg.interface
+        if self.simulate and self.sim is None:
+            self.sim = SimBus(cfg.channel, [
+                SimDrive(d.node_id, d.eds, cfg.period)
+                for d in cfg.drives]).start()
+        network = canopen.Network()
+        network.NOTIFIER_CYCLE = 0.1        # quick stop
+        kwargs = {} if interface == "virtual" else {"bitrate": cfg.bitrate}
+        network.connect(interface=interface, channel=cfg.channel, **kwargs)
+        network.notifier.add_listener(_FrameWatch(self))
+        self.network = network
+        for link in self.drives:
+            link.attach(network)
+
+    def close(self) -> None:
+        network, self.network = self.network, None
+        for link in self.drives:
+            link.detach(stop=network is not None)
+        if network is not None:
+            network.disconnect()
+
+    def shutdown(self) -> None:
+        super().shutdown()
+        if self.sim is not None:
+            self.sim.stop()
+            self.sim = None
+
+    def read(self) -> None:
+        self.network.check()
+        for link in self.drives:
+            link.read()
+        with self._count_lock:
+            self.comp["unknown-frames"] = self._unknown & 0xFFFFFFFF
+            self.comp["malformed-frames"] = self._malformed & 0xFFFFFFFF
+
+    def write(self) -> None:
+        for link in self.drives:
+            link.write()
+        self.network.send_message(0x80, b"")          # SYNC
