@@ -15,6 +15,7 @@ import canopen
 from canopen.sdo import SdoAbortedError, SdoClient, SdoCommunicationError
 
 from halsdk.component import Component
+from halsdk.driver.backoff import Backoff
 from halsdk.drivers.cia402 import statemachine as sm
 from halsdk.drivers.cia402.codes import abort_text, emcy_text
 from halsdk.drivers.cia402.config import DriveConfig, PdoEntry
@@ -70,8 +71,7 @@ class DriveLink:
         self.network: Optional[canopen.Network] = None
         self.sdo: Optional[SdoClient] = None
         self.link = CONFIGURE
-        self.next_attempt = 0.0
-        self.backoff = 0.25
+        self.retry = Backoff(0.25, 5.0)
         self.comm_fault = 0          # CODE_* while a link problem lasts
         self.comm_text = ""
         self.fault_text = ""         #: the text of the current fault
@@ -103,7 +103,7 @@ class DriveLink:
         for cob in self._tpdo_by_cob:
             network.subscribe(cob, self._on_tpdo)
         self.link = CONFIGURE
-        self.next_attempt = 0.0
+        self.retry.succeeded()          # configure at once
 
     def detach(self, stop: bool) -> None:
         """Leave the network (NMT stop first when ``stop``)."""
@@ -271,17 +271,16 @@ class DriveLink:
                            "heartbeat back, configuring again",
                            logging.WARNING)
                 self.link = CONFIGURE
-                self.next_attempt = 0.0
-        if self.link == CONFIGURE and now >= self.next_attempt:
+                self.retry.succeeded()
+        if self.link == CONFIGURE and self.retry.ready(now):
             try:
                 self.configure()
             except SdoConfigError as exc:
                 self._comm_fault(exc.code, str(exc), exc.abort)
-                self.next_attempt = now + self.backoff
-                self.backoff = min(self.backoff * 2, 5.0)
+                self.retry.failed(now)
             else:
                 self.link = RUNNING
-                self.backoff = 0.25
+                self.retry.succeeded()
                 self.drive_state = sm.NO_DATA
                 if self.comm_fault:
                     log.warning("%s: configured, running again", self.name)
