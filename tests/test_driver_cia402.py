@@ -129,6 +129,19 @@ def test_enable_and_csp_follows(rig_for):
     assert hal.getp("cia402.period") > 0
 
 
+def test_exit_switches_the_power_stage_off_before_nmt_stop(rig_for):
+    rig = rig_for()
+    enable(rig)
+    sim = rig.driver.sim[1]
+    assert sim.state == sm.OPERATION_ENABLED
+    rig.stop()                      # the driver closes the bus
+    # "shutdown" arrived before NMT stop: ready to switch on, not the
+    # switch on disabled that a bare NMT stop leaves behind
+    assert sim.get(0x6040) == sm.CW_SHUTDOWN
+    assert sim.state == sm.READY_TO_SWITCH_ON
+    assert sim.nmt_state != 5
+
+
 def test_csv_velocity(rig_for):
     rig = rig_for(CSP_DRIVE.replace("csp", "csv"))
     enable(rig)

@@ -371,6 +371,23 @@ class DriveLink:
             target = self._pp_target if self._pp_target is not None \
                 else target
         comp[p + "controlword"] = cw
+        self._send_rpdos(cw, target)
+
+    def switch_off(self) -> None:
+        """Send controlword "shutdown" (power stage off) with the last
+        targets: the drive leaves operation enabled at the next SYNC."""
+        if self.link != RUNNING or self.network is None:
+            return
+        p = self.pin
+        target = int(round(self.comp[p + "position-cmd"]
+                           * self.cfg.position_scale))
+        if self._pp_target is not None:
+            target = self._pp_target
+        self.comp[p + "controlword"] = sm.CW_SHUTDOWN
+        self._send_rpdos(sm.CW_SHUTDOWN, target)
+
+    def _send_rpdos(self, cw: int, target: int) -> None:
+        comp, p, cfg = self.comp, self.pin, self.cfg
         values = {0x6040: cw, 0x607A: target,
                   0x60FF: int(round(comp[p + "velocity-cmd"]
                                     * cfg.velocity_scale)),

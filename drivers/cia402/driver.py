@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import logging
 import threading
+import time
 from typing import Optional
 
 import can
@@ -121,6 +122,17 @@ class Cia402Driver(Driver):
 
     def close(self) -> None:
         network, self.network = self.network, None
+        if network is not None:
+            # power stages off before NMT stop: a stopped node would react
+            # as its 0x6007 setting says, which may leave the motor live
+            try:
+                for link in self.drives:
+                    link.switch_off()
+                network.send_message(0x80, b"")      # SYNC applies them
+                time.sleep(2 * self.config.period)
+            except Exception as exc:   # the bus may be gone already
+                log.debug("%s: switching the drives off: %s",
+                          self.prefix, exc)
         for link in self.drives:
             link.detach(stop=network is not None)
         if network is not None:
