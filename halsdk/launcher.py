@@ -20,7 +20,13 @@ What the launcher does, in order:
 4. starts the realtime threads and runs ``[HAL]POSTGUI_HALFILE``;
 5. runs until SIGINT (Ctrl-C) or SIGTERM, or for ``seconds`` when given;
 6. shuts down: motion disabled, ``[HAL]SHUTDOWN`` run, threads stopped,
-   every module unloaded and the instance removed.
+   ``loadusr`` programs still running ended (SIGTERM, then SIGKILL after
+   5 s), every module unloaded and the instance removed.
+
+The HAL files run in the INI file's folder, as LinuxCNC runs them: a
+relative path given to ``source`` or to a ``loadusr`` program (its
+configuration file, say) is taken from there, and the programs start
+there, whatever the current folder of ``halsdk run``.
 
 Whatever fails on the way, the machine is left safe: motion is disabled
 before anything else is torn down, and the instance is removed.
@@ -63,6 +69,10 @@ class Launcher:
         self.motion: Any = None
         self.io: Any = None             # the I/O controller, with [EMCIO]
         self._stop = threading.Event()
+        # HAL files run in the INI file's folder, as LinuxCNC does: relative
+        # paths of sourced files and loadusr programs and their arguments
+        self.workdir = os.path.dirname(os.path.abspath(self.ini.path))
+        self._executors: list[Any] = []     # their loadusr programs
 
     # ------------------------------------------------------------ start
 
@@ -70,7 +80,6 @@ class Launcher:
         """Steps 1 to 4; raises LaunchError (after shutting down what was
         started)."""
         import halsdk
-        from halsdk.halcmd.commands import Executor
         halfiles = self.ini.all("HAL", "HALFILE")
         if not halfiles:
             raise LaunchError(f"{self.ini.path}: [HAL]HALFILE is missing "
@@ -83,7 +92,7 @@ class Launcher:
         self.hal = halsdk.Hal(create=True)
         try:
             self._start_io()
-            ex = Executor(self.hal, ini=self.ini.path, register=False)
+            ex = self._executor()
             self._load(ex, halfiles)
             self._configure_motion()
             if self.io is not None and self.motion is not None:
@@ -97,6 +106,13 @@ class Launcher:
         except BaseException:
             self.shutdown()
             raise
+
+    def _executor(self, hal: Any = None) -> Any:
+        from halsdk.halcmd.commands import Executor
+        ex = Executor(hal or self.hal, ini=self.ini.path, register=False,
+                      workdir=self.workdir)
+        self._executors.append(ex)
+        return ex
 
     def _start_io(self) -> None:
         if not self.ini.has_section("EMCIO"):
@@ -164,10 +180,12 @@ class Launcher:
                     print(f"halsdk run: disabling motion: {e}",
                           file=self.err)
             for name in self.ini.all("HAL", "SHUTDOWN"):
-                from halsdk.halcmd.commands import Executor
-                ex = Executor(hal, ini=self.ini.path, register=False)
-                ex.run_file(_path(self.ini, name))
+                self._executor(hal).run_file(_path(self.ini, name))
             hal.stop()
+            # programs that the HAL files started and nothing ended
+            executors, self._executors = self._executors, []
+            for ex in executors:
+                ex.end_children()
         finally:
             io, self.io = self.io, None
             if io is not None:

@@ -106,3 +106,48 @@ def test_in_process_start_configures_motion(monkeypatch):
 def test_an_unreadable_ini_is_an_error(tmp_path):
     with pytest.raises(LaunchError, match="nothing.ini: cannot read"):
         Launcher(str(tmp_path / "nothing.ini"))
+
+
+PROBE = """\
+import signal, sys, time
+from halsdk.component import component
+
+with open(sys.argv[1]) as f:                # relative: the INI's folder
+    value = int(f.read())
+comp = component("probe")
+comp.newpin("value", "s32", "out")
+comp["value"] = value
+comp.ready()
+
+
+def ended(*_):
+    with open("ended", "w") as f:
+        f.write("SIGTERM")
+    comp.exit()
+    sys.exit(0)
+
+
+signal.signal(signal.SIGTERM, ended)
+while True:
+    time.sleep(0.02)
+"""
+
+
+def test_hal_files_run_in_the_ini_folder_and_programs_are_ended(tmp_path):
+    machine = tmp_path / "machine"
+    machine.mkdir()
+    write(machine, "probe.py", PROBE)
+    write(machine, "probe.conf", "42\n")
+    write(machine, "more.hal", "net answer probe.value\n")
+    write(machine, "m.hal", f"loadusr -Wn probe {sys.executable} probe.py "
+          "probe.conf\nsource more.hal\n")
+    ini = write(machine, "m.ini", "[HAL]\nHALFILE = m.hal\n")
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    proc = halsdk_run(elsewhere, str(ini), "--seconds", "0.3")
+    out, err = proc.communicate(timeout=60)
+    assert proc.returncode == 0, err
+    # the program found its relative configuration, ran in the machine's
+    # folder, and was ended by the shutdown, not left behind
+    assert (machine / "ended").read_text() == "SIGTERM"
+    assert not (elsewhere / "ended").exists()

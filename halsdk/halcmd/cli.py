@@ -8,7 +8,6 @@ file, one command from its arguments, or a prompt.
 
 from __future__ import annotations
 
-import subprocess
 import sys
 from typing import Optional
 
@@ -260,19 +259,7 @@ def _teardown(hal, ex: Executor, opts: _Options) -> None:
         hal.stop()
     except HalError:
         pass
-    _end_children(ex)
-
-
-def _end_children(ex: Executor) -> None:
-    """Programs started by loadusr and still running get SIGTERM."""
-    for child in ex.children:
-        if child.poll() is None:
-            child.terminate()
-            try:
-                child.wait(timeout=5)
-            except subprocess.TimeoutExpired:
-                child.kill()
-                child.wait()
+    ex.end_children()
 
 
 def halcmd_main(argv: Optional[list[str]] = None) -> int:

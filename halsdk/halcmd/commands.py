@@ -151,14 +151,19 @@ class Executor:
     :param echo: start with echo on (``-e``).
     :param warn_long_names: print a warning when a command creates a name
         longer than the reference's 47 characters (never with ``-Q``).
+    :param workdir: the folder in which relative paths of ``source`` and
+        ``loadusr`` programs are taken (default: the current folder); a
+        machine's launcher gives the INI file's folder, as LinuxCNC does.
     """
 
     def __init__(self, hal, out: Optional[Out] = None,
                  err: Optional[Out] = None, *, keep_going: bool = False,
                  script: bool = False, verbose: int = 0,
                  ini: Optional[str] = None, echo: bool = False,
-                 register: bool = True, warn_long_names: bool = True):
+                 register: bool = True, warn_long_names: bool = True,
+                 workdir: Optional[str] = None):
         self.hal = hal
+        self.workdir = workdir
         if verbose < 0:
             out = _discard
         self.out = out or _writer(sys.stdout)
@@ -207,12 +212,30 @@ class Executor:
         prefix = f"{self.filename}:{self.lineno}: " if self.filename else ""
         self.err(prefix + message + "\n")
 
+    def _in_workdir(self, path: str) -> str:
+        if self.workdir is None or os.path.isabs(path):
+            return path
+        return os.path.join(self.workdir, path)
+
+    def end_children(self, timeout: float = 5.0) -> None:
+        """Programs started by ``loadusr`` and still running get SIGTERM,
+        then SIGKILL if they have not ended after ``timeout`` seconds."""
+        for child in self.children:
+            if child.poll() is None:
+                child.terminate()
+                try:
+                    child.wait(timeout=timeout)
+                except subprocess.TimeoutExpired:
+                    child.kill()
+                    child.wait()
+
     def run_file(self, path: str, keep_going: Optional[bool] = None) -> int:
         """Run a file ("-" is stdin); returns the number of failures."""
         if path == "-":
             return self.run_lines(sys.stdin, "<stdin>", keep_going)
         try:
-            f = open(path, encoding="utf-8", errors="replace")
+            f = open(self._in_workdir(path), encoding="utf-8",
+                     errors="replace")
         except OSError as exc:
             self.err(f"Could not open hal file '{path}': "
                      f"{exc.strerror}\n")
@@ -432,7 +455,8 @@ class Executor:
                                "permitted")
         try:
             child = subprocess.Popen([_program_path(prog), *args[1:]],
-                                     stdin=subprocess.DEVNULL)
+                                     stdin=subprocess.DEVNULL,
+                                     cwd=self.workdir)
         except OSError as exc:
             raise CommandError(f"execv({prog}): {exc.strerror}",
                                f"program '{prog}' failed, returned 1"
