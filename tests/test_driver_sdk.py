@@ -17,6 +17,7 @@ from halsdk.driver import (
     FAULT_OPEN,
     FAULT_READ,
     STAT_PINS,
+    Backoff,
     Driver,
     DriverError,
     IOLoop,
@@ -266,9 +267,24 @@ def test_threaded_loop_clean_stop(hal):
     assert not hal.pins("fakedev.1.*")
 
 
-def test_bad_loop_arguments():
+@pytest.mark.parametrize("kw", [
+    {"period": 0}, {"period": -1}, {"period": float("nan")},
+    {"period": float("inf")}, {"period": 1e300},
+    {"backoff": 0}, {"backoff": float("nan")}, {"backoff_max": 1e300},
+    {"backoff": 2.0, "backoff_max": 1.0}])
+def test_bad_loop_arguments(kw):
+    # a bad number is refused here, not an OverflowError in the loop
     with pytest.raises(ValueError):
-        IOLoop(Driver(), period=0)
+        IOLoop(Driver(), **kw)
+
+
+def test_backoff_doubles_to_the_maximum_and_resets():
+    retry = Backoff(0.5, 2.0)
+    assert retry.ready(0.0)
+    assert [retry.failed(10.0) for _ in range(4)] == [0.5, 1.0, 2.0, 2.0]
+    assert not retry.ready(11.9) and retry.ready(12.0)
+    retry.succeeded()
+    assert retry.ready(0.0) and retry.failed(20.0) == 0.5
 
 
 def test_sigterm_stops_loadusr_process(tmp_path, hal):

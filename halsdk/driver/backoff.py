@@ -2,6 +2,11 @@
 
 from __future__ import annotations
 
+import math
+
+#: the longest wait between two attempts, in seconds
+MAX_DELAY = 3600.0
+
 
 class Backoff:
     """When to try again after failures: the first retry waits ``first``
@@ -12,8 +17,10 @@ class Backoff:
     """
 
     def __init__(self, first: float = 0.1, maximum: float = 5.0):
-        if first <= 0 or maximum < first:
-            raise ValueError("back-off needs first > 0 and maximum >= first")
+        if not (math.isfinite(first) and math.isfinite(maximum)
+                and 0 < first <= maximum <= MAX_DELAY):
+            raise ValueError("back-off needs 0 < first <= maximum <= "
+                             f"{MAX_DELAY:g} s, not {first!r}, {maximum!r}")
         self.first = first
         self.maximum = maximum
         self.delay = first          # wait after the next failure

@@ -3,6 +3,7 @@ statistics, reconnect with exponential back-off, stop on a signal."""
 
 from __future__ import annotations
 
+import math
 import signal
 import threading
 import time
@@ -18,6 +19,9 @@ from halsdk.driver.base import (
     log,
 )
 from halsdk.errors import HalError
+
+#: the longest cycle of a loop, in seconds
+MAX_PERIOD = 3600.0
 
 #: timing pins created on the driver's component (float, seconds)
 STAT_PINS = ("period", "max-period", "read-time", "write-time")
@@ -46,8 +50,9 @@ class IOLoop:
                  backoff: float = 0.1, backoff_max: float = 5.0,
                  clock: Callable[[], float] = time.monotonic,
                  sleep: Optional[Callable[[float], None]] = None):
-        if period <= 0:
-            raise ValueError("period must be > 0")
+        if not (math.isfinite(period) and 0 < period <= MAX_PERIOD):
+            raise ValueError(f"period must be > 0 and at most {MAX_PERIOD:g} "
+                             f"s, not {period!r}")
         self.driver = driver
         self.period = period
         self.retry = Backoff(backoff, backoff_max)
