@@ -6,6 +6,7 @@ from __future__ import annotations
 import logging
 import os
 import shutil
+import signal
 import subprocess
 import sys
 import textwrap
@@ -17,6 +18,7 @@ import pytest
 
 from halsdk.driver import IOLoop
 from halsdk.drivers.cia402 import statemachine as sm
+from halsdk.drivers.cia402.__main__ import main
 from halsdk.drivers.cia402.codes import emcy_text
 from halsdk.drivers.cia402.config import ConfigError, load
 from halsdk.drivers.cia402.driver import Cia402Driver
@@ -288,6 +290,96 @@ def test_bad_config_names_file_and_line(tmp_path, drives, line, text):
         load(str(path))
     assert str(info.value).startswith(f"{path}:{line}: ")
     assert text in str(info.value)
+
+
+DRIVE = "[DRIVE_0]\nNODE_ID = 1\n"
+
+
+@pytest.mark.parametrize("text, line, message", [
+    ("[BUS]\nPERIOD = 1e300\n" + DRIVE, 2, "PERIOD must be at most 1,"),
+    ("[BUS]\nPERIOD = nan\n" + DRIVE, 2, "'nan' is not a finite number"),
+    ("[BUS]\nPERIOD = inf\n" + DRIVE, 2, "'inf' is not a finite number"),
+    ("[BUS]\nSDO_TIMEOUT = 1e300\n" + DRIVE, 2,
+     "SDO_TIMEOUT must be at most 60,"),
+    ("[BUS]\nBITRATE = 1.5\n" + DRIVE, 2, "BITRATE must be a whole"),
+    ("[BUS]\nBITRATE = 1e300\n" + DRIVE, 2, "BITRATE must be at most"),
+    ("[BUS]\nINTERFACE = nosuch\n" + DRIVE, 2, "unknown INTERFACE"),
+    ("[BUS]\n[DRIVE_0]\nNODE_ID = nan\n", 3, "not a finite number"),
+    ("[BUS]\n" + DRIVE + "HEARTBEAT_TIMEOUT = inf\n", 4,
+     "not a finite number"),
+    ("[BUS]\n" + DRIVE + "HEARTBEAT_PERIOD = 1e300\n", 4,
+     "HEARTBEAT_PERIOD must be at most 60,"),
+    ("[BUS]\n" + DRIVE + "POSITION_SCALE = -inf\n", 4,
+     "not a finite number"),
+    ("[BUS]\n" + DRIVE + "MODE = pp\nPROFILE_VELOCITY = 1e300\n", 5,
+     "PROFILE_VELOCITY times POSITION_SCALE must be at most"),
+    # repeated sections merge and the first key wins in a plain INI
+    # reader: both would hide a mistake, so both are errors
+    ("[BUS]\n" + DRIVE + "[DRIVE_0]\nMODE = csv\n", 4,
+     "[DRIVE_0] is given again (first at line 2)"),
+    ("[BUS]\nPERIOD = 0.01\n" + DRIVE + "[BUS]\nPERIOD = 0.02\n", 5,
+     "[BUS] is given again (first at line 1)"),
+    ("[BUS]\n" + DRIVE + "NODE_ID = 2\n", 4,
+     "NODE_ID is given again in [DRIVE_0] (first at line 3)"),
+    ("PERIOD = 0.01\n[BUS]\n" + DRIVE, 1, "PERIOD is outside a section"),
+])
+def test_bad_numbers_and_repeats_name_file_and_line(tmp_path, text, line,
+                                                    message):
+    path = tmp_path / "drives.ini"
+    path.write_text(text)
+    with pytest.raises(ConfigError) as info:
+        load(str(path))
+    assert str(info.value).startswith(f"{path}:{line}: ")
+    assert message in str(info.value)
+
+
+def test_sdo_lines_may_repeat(tmp_path):
+    path = write_ini(tmp_path, CSP_DRIVE + "SDO = 0x6065:00 500\n"
+                     "SDO = 0x6065:00 700\n")
+    writes = load(str(path)).drives[0].sdo_writes
+    assert [(w.index, w.value) for w in writes] == [(0x6065, 500),
+                                                    (0x6065, 700)]
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--bogus"], "unrecognized arguments: --bogus"),
+    (["--bogus", "drives.ini"], "unrecognized arguments: --bogus"),
+    ([], "missing the drive configuration file"),
+    (["-n"], "argument -n/--name: expected one argument"),
+    (["-n", "", "drives.ini"], "-n/--name must not be empty"),
+])
+def test_usage_errors_exit_1_with_one_line(capsys, argv, message):
+    assert main(argv) == 1
+    err = capsys.readouterr().err
+    assert err.startswith(f"cia402: {message}")
+    assert err.count("\n") == 1
+
+
+def test_open_error_names_the_channel_and_is_logged_once(hal, tmp_path):
+    """No INFO flood while the bus cannot be opened; one line in the
+    format of the other programs, naming the interface and channel."""
+    ini = tmp_path / "drives.ini"
+    ini.write_text("[BUS]\nINTERFACE = socketcan\nCHANNEL = cia402-none\n"
+                   "PERIOD = 0.01\n" + DRIVE)
+    err_path = tmp_path / "stderr.txt"
+    with open(err_path, "w") as err:
+        proc = subprocess.Popen(
+            [sys.executable, "-m", "halsdk.drivers.cia402", str(ini)],
+            cwd=tmp_path, stdout=subprocess.DEVNULL, stderr=err)
+    try:
+        wait_for(lambda: "open failed" in err_path.read_text(), 20,
+                 "the open error")
+        time.sleep(0.8)          # several reconnect attempts
+        proc.send_signal(signal.SIGTERM)
+        assert proc.wait(timeout=20) == 0
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    lines = err_path.read_text().splitlines()
+    assert len(lines) == 1, lines
+    assert lines[0].startswith("cia402: open failed: socketcan channel "
+                               "cia402-none: ")
 
 
 def test_bad_config_exits_1_with_message(tmp_path):

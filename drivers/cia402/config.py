@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+import math
 import os
 import re
 import struct
 from dataclasses import dataclass, field
 from typing import Optional
 
+import can
 import canopen
 from canopen.objectdictionary import ObjectDictionary, ODVariable
 
@@ -30,6 +32,16 @@ SDO_TYPES = {"u8": 0x5, "u16": 0x6, "u32": 0x7, "i8": 0x2, "i16": 0x3,
              "i32": 0x4, "f32": 0x8}
 DEFAULT_RPDO = {1: [(0x6040, 0), (0x607A, 0)], 2: [(0x60FF, 0)]}
 DEFAULT_TPDO = {1: [(0x6041, 0), (0x6064, 0)], 2: [(0x606C, 0)]}
+#: keys that may be given more than once in a section
+REPEATABLE = {"SDO"}
+#: the longest driver cycle (PERIOD), in seconds
+MAX_PERIOD = 1.0
+#: the longest SDO and heartbeat time, in seconds
+MAX_TIMEOUT = 60.0
+#: the fastest nominal bit rate of classic CAN, in bit/s
+MAX_BITRATE = 1_000_000
+#: the largest profile value in drive units (0x6081, 0x6083, 0x6084: u32)
+MAX_COUNTS = 0xFFFFFFFF
 
 
 class ConfigError(Exception):
@@ -110,7 +122,9 @@ class _Reader:
         return default if value is None or value == "" else value
 
     def number(self, section: str, key: str, default: float,
-               low: float = float("-inf"), positive: bool = False) -> float:
+               low: float = float("-inf"), positive: bool = False,
+               high: float = float("inf")) -> float:
+        """A finite number in [low, high] (> 0 when ``positive``)."""
         raw = self.ini.get(section, key)
         if raw is None or raw == "":
             return default
@@ -120,10 +134,16 @@ class _Reader:
         except ValueError:
             raise self.fail(section, key,
                             f"{key} = {raw!r} is not a number") from None
+        if not math.isfinite(value):
+            raise self.fail(section, key,
+                            f"{key} = {raw!r} is not a finite number")
         if value < low or (positive and value <= 0):
             bound = "> 0" if positive else f">= {low:g}"
             raise self.fail(section, key, f"{key} must be {bound}, "
                             f"not {raw}")
+        if value > high:
+            raise self.fail(section, key, f"{key} must be at most "
+                            f"{high:g}, not {raw}")
         return value
 
     def check_keys(self, section: str, allowed: set[str]) -> None:
@@ -260,12 +280,20 @@ def _drive(r: _Reader, num: int, base: str) -> DriveConfig:
     drive = DriveConfig(
         num=num, node_id=int(node_id), eds=eds, od=od, mode=mode,
         position_scale=pscale, velocity_scale=vscale,
-        heartbeat_timeout=r.number(section, "HEARTBEAT_TIMEOUT", 0.5, 0.0),
-        heartbeat_period=r.number(section, "HEARTBEAT_PERIOD", 0.1, 0.0),
+        heartbeat_timeout=r.number(section, "HEARTBEAT_TIMEOUT", 0.5, 0.0,
+                                   high=MAX_TIMEOUT),
+        heartbeat_period=r.number(section, "HEARTBEAT_PERIOD", 0.1, 0.0,
+                                  high=MAX_TIMEOUT),
         profile_velocity=r.number(section, "PROFILE_VELOCITY", 0.0, 0.0),
         profile_acceleration=accel,
         profile_deceleration=r.number(section, "PROFILE_DECELERATION",
                                       accel, 0.0))
+    for key, value in (("PROFILE_VELOCITY", drive.profile_velocity),
+                       ("PROFILE_ACCELERATION", drive.profile_acceleration),
+                       ("PROFILE_DECELERATION", drive.profile_deceleration)):
+        if abs(value * pscale) > MAX_COUNTS:
+            raise r.fail(section, key, f"{key} times POSITION_SCALE must "
+                         f"be at most {MAX_COUNTS} drive units")
     if 0 < drive.heartbeat_timeout <= drive.heartbeat_period:
         raise r.fail(section, "HEARTBEAT_TIMEOUT", "HEARTBEAT_TIMEOUT must "
                      "be larger than HEARTBEAT_PERIOD")
@@ -276,12 +304,42 @@ def _drive(r: _Reader, num: int, base: str) -> DriveConfig:
     return drive
 
 
+def _check_repeats(ini: IniFile) -> None:
+    """Reject a repeated section header, a repeated key (but ``SDO``) and
+    a key before the first section; the error names the later line."""
+    problems: list[tuple[int, str]] = []
+    try:
+        with open(ini.path, encoding="utf-8", errors="replace") as f:
+            lines = f.read().splitlines()
+    except OSError as exc:
+        raise ConfigError(f"{ini.path}: cannot read: {exc.strerror}") \
+            from None
+    for number, raw in enumerate(lines, 1):
+        line = raw.strip()
+        if line.startswith("[") and "]" in line:
+            section = line[1:line.index("]")]
+            first = ini.section_lines.get(section, number)
+            if first != number:
+                problems.append((number, f"[{section}] is given again "
+                                 f"(first at line {first})"))
+    for (section, key), found in ini.every.items():
+        if section == "":
+            problems.append((found[0][1], f"{key} is outside a section"))
+        elif len(found) > 1 and key not in REPEATABLE:
+            problems.append((found[1][1], f"{key} is given again in "
+                             f"[{section}] (first at line {found[0][1]})"))
+    if problems:
+        number, text = min(problems)
+        raise ConfigError(f"{ini.path}:{number}: {text}")
+
+
 def load(path: str) -> BusConfig:
     """Read and check a drive configuration file."""
     try:
         ini = IniFile(path)
     except OSError as exc:
         raise ConfigError(f"{path}: cannot read: {exc.strerror}") from None
+    _check_repeats(ini)
     r = _Reader(ini)
     base = os.path.dirname(os.path.abspath(path))
     for section in ini.section_lines:
@@ -292,13 +350,23 @@ def load(path: str) -> BusConfig:
     simulate = r.text(BUS, "SIMULATE", "0").lower()
     if simulate not in ("0", "1", "yes", "no", "true", "false"):
         raise r.fail(BUS, "SIMULATE", "SIMULATE must be 0 or 1")
+    interface = r.text(BUS, "INTERFACE", "socketcan")
+    if interface not in can.VALID_INTERFACES:
+        raise r.fail(BUS, "INTERFACE", f"unknown INTERFACE {interface!r} "
+                     f"(one of {', '.join(sorted(can.VALID_INTERFACES))})")
+    bitrate = r.number(BUS, "BITRATE", MAX_BITRATE, positive=True,
+                       high=MAX_BITRATE)
+    if bitrate != int(bitrate):
+        raise r.fail(BUS, "BITRATE", "BITRATE must be a whole number")
     bus = BusConfig(
-        interface=r.text(BUS, "INTERFACE", "socketcan"),
+        interface=interface,
         channel=r.text(BUS, "CHANNEL", "can0"),
-        bitrate=int(r.number(BUS, "BITRATE", 1000000, positive=True)),
-        period=r.number(BUS, "PERIOD", 0.01, positive=True),
+        bitrate=int(bitrate),
+        period=r.number(BUS, "PERIOD", 0.01, positive=True,
+                        high=MAX_PERIOD),
         simulate=simulate in ("1", "yes", "true"),
-        sdo_timeout=r.number(BUS, "SDO_TIMEOUT", 0.3, positive=True),
+        sdo_timeout=r.number(BUS, "SDO_TIMEOUT", 0.3, positive=True,
+                             high=MAX_TIMEOUT),
         path=path)
     nums = sorted(int(s[6:]) for s in ini.section_lines
                   if s.startswith("DRIVE_"))

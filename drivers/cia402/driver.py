@@ -114,7 +114,14 @@ class Cia402Driver(Driver):
         network = canopen.Network()
         network.NOTIFIER_CYCLE = 0.1        # quick stop
         kwargs = {} if interface == "virtual" else {"bitrate": cfg.bitrate}
-        network.connect(interface=interface, channel=cfg.channel, **kwargs)
+        try:
+            network.connect(interface=interface, channel=cfg.channel,
+                            **kwargs)
+        except Exception as exc:  # python-can raises many kinds
+            reason = exc.strerror if isinstance(exc, OSError) and \
+                exc.strerror else str(exc) or type(exc).__name__
+            raise ConnectionError(f"{interface} channel {cfg.channel}: "
+                                  f"{reason}") from None
         network.notifier.add_listener(_FrameWatch(self))
         self.network = network
         for link in self.drives:
