@@ -4,6 +4,7 @@ pseudo-terminal pair (RTU)."""
 from __future__ import annotations
 
 import importlib.util
+import logging
 import os
 import pty
 import select
@@ -18,6 +19,7 @@ from pathlib import Path
 import pytest
 
 from halsdk.drivers.mb2hal import ConfigError, Mb2hal, load_config
+from halsdk.drivers.mb2hal.client import ModbusLink
 
 ROOT = Path(__file__).resolve().parents[1]
 _spec = importlib.util.spec_from_file_location(
@@ -51,10 +53,10 @@ def client(port):
 INIT = "[MB2HAL_INIT]\nINIT_DEBUG=0\nVERSION=1.1\nTOTAL_TRANSACTIONS={n}\n"
 
 
-def tcp_head(port, rate=50.0, timeout=300):
+def tcp_head(port, rate=50.0, timeout=300, debug=0):
     return (f"LINK_TYPE=tcp\nTCP_IP=127.0.0.1\nTCP_PORT={port}\n"
             f"MB_SLAVE_ID=1\nMAX_UPDATE_RATE={rate}\n"
-            f"MB_RESPONSE_TIMEOUT_MS={timeout}\nDEBUG=0\n")
+            f"MB_RESPONSE_TIMEOUT_MS={timeout}\nDEBUG={debug}\n")
 
 
 def write_ini(tmp_path, sections, init=INIT, name="t.ini"):
@@ -229,11 +231,18 @@ def test_timeout_is_counted_and_other_link_continues(tmp_path, hal, server,
     assert time.monotonic() - t0 < 3.0
 
 
-def test_server_restart_errors_then_recovery(tmp_path, hal, engine_of):
+def messages(caplog, text):
+    return [r.getMessage() for r in caplog.records
+            if r.name == "halsdk.mb2hal" and text in r.getMessage()]
+
+
+def test_server_restart_errors_then_recovery(tmp_path, hal, engine_of,
+                                             caplog):
+    caplog.set_level(logging.INFO, logger="halsdk.mb2hal")
     port = free_port()
     srv = sim.ServerThread(port=port).start()
-    ini = write_ini(tmp_path, [tcp_head(port, timeout=200) + "MB_TX_CODE="
-                               "fnct_03_read_holding_registers\n"
+    ini = write_ini(tmp_path, [tcp_head(port, timeout=200, debug=1) +
+                               "MB_TX_CODE=fnct_03_read_holding_registers\n"
                                "FIRST_ELEMENT=3\nNELEMENTS=1\n"])
     engine_of(ini, backoff=0.02, backoff_max=0.1)
     try:
@@ -244,6 +253,7 @@ def test_server_restart_errors_then_recovery(tmp_path, hal, engine_of):
         assert hal.getp("mb2hal.00.num_errors") == 0
         srv.stop()
         assert wait_for(lambda: hal.getp("mb2hal.00.num_errors") >= 2)
+        assert not messages(caplog, "connected again")
         srv = sim.ServerThread(port=port).start()
         c = client(port)
         c.write_registers(3, [12], device_id=1)
@@ -252,8 +262,99 @@ def test_server_restart_errors_then_recovery(tmp_path, hal, engine_of):
         errors = hal.getp("mb2hal.00.num_errors")
         time.sleep(0.1)
         assert hal.getp("mb2hal.00.num_errors") == errors   # healthy again
+        assert len(messages(caplog, "connected again")) == 1
     finally:
         srv.stop()
+
+
+@pytest.fixture
+def closing_server():
+    """Accepts every connection and closes it at once."""
+    lsock = socket.socket()
+    lsock.bind(("127.0.0.1", 0))
+    lsock.listen(8)
+    lsock.settimeout(0.05)
+    stop = threading.Event()
+
+    def serve():
+        while not stop.is_set():
+            try:
+                lsock.accept()[0].close()
+            except OSError:
+                pass
+    t = threading.Thread(target=serve, daemon=True)
+    t.start()
+    try:
+        yield lsock.getsockname()[1]
+    finally:
+        stop.set()
+        t.join(5)
+        lsock.close()
+
+
+@pytest.mark.parametrize("kind", ["closing", "silent"])
+def test_accepting_but_broken_server_is_logged_once(
+        tmp_path, hal, engine_of, caplog, closing_server, silent_server,
+        kind):
+    caplog.set_level(logging.INFO, logger="halsdk.mb2hal")
+    port = closing_server if kind == "closing" else silent_server
+    ini = write_ini(tmp_path, [
+        tcp_head(port, rate=0.0, timeout=30, debug=1) + "MB_TX_CODE="
+        "fnct_03_read_holding_registers\nFIRST_ELEMENT=0\nNELEMENTS=1\n"])
+    eng = engine_of(ini, backoff=0.005, backoff_max=0.01)
+    assert wait_for(lambda: hal.getp("mb2hal.00.num_errors") >= 20)
+    logged = [r.getMessage() for r in caplog.records
+              if r.name == "halsdk.mb2hal"]
+    # a TCP connect alone is no recovery; each distinct problem once
+    assert not messages(caplog, "connected")
+    assert 1 <= len(logged) <= 6, logged
+    assert not [m for m in logged if "Modbus" in m or "seconds" in m]
+    assert eng.transactions_done == 0
+
+
+def test_unexpected_error_in_transaction_keeps_link_alive(
+        tmp_path, hal, server, engine_of, caplog, monkeypatch):
+    real = ModbusLink.execute
+    broken = threading.Event()
+    broken.set()
+
+    def execute(self, tx, values=None):
+        if broken.is_set():
+            raise RuntimeError("boom")
+        return real(self, tx, values)
+    monkeypatch.setattr(ModbusLink, "execute", execute)
+    ini = write_ini(tmp_path, [tcp_head(server.port, debug=1) + "MB_TX_CODE="
+                               "fnct_04_read_input_registers\n"
+                               "FIRST_ELEMENT=0\nNELEMENTS=1\n"])
+    eng = engine_of(ini, backoff=0.005, backoff_max=0.01)
+    assert wait_for(lambda: hal.getp("mb2hal.00.num_errors") >= 5)
+    assert eng.workers[0].thread.is_alive()
+    assert len(messages(caplog, "RuntimeError: boom")) == 1
+    assert len(messages(caplog, "")) == 1
+    broken.clear()
+    assert wait_for(lambda: hal.getp("mb2hal.00.00.int") == 7)
+    errors = hal.getp("mb2hal.00.num_errors")
+    time.sleep(0.05)
+    assert hal.getp("mb2hal.00.num_errors") == errors
+
+
+def test_unexpected_error_between_transactions_is_counted_once_logged(
+        tmp_path, hal, server, caplog):
+    ini = write_ini(tmp_path, [tcp_head(server.port, debug=1) + "MB_TX_CODE="
+                               "fnct_04_read_input_registers\n"
+                               "FIRST_ELEMENT=0\nNELEMENTS=1\n"])
+    config = load_config(ini)
+    config.slowdown = 1e300         # what the config check now refuses
+    eng = Mb2hal(config, backoff=0.005, backoff_max=0.01)
+    eng.start()
+    try:
+        assert wait_for(lambda: hal.getp("mb2hal.00.num_errors") >= 5)
+        assert eng.workers[0].thread.is_alive()
+        assert hal.getp("mb2hal.00.00.int") == 7
+        assert len(messages(caplog, "OverflowError")) == 1
+        assert len(messages(caplog, "")) == 1       # nothing else
+    finally:
+        eng.stop()
 
 
 def test_no_device_counts_on_every_transaction_of_the_link(tmp_path, hal,
@@ -318,6 +419,40 @@ BAD = [
 ]
 
 
+TX = ("[TRANSACTION_00]\nLINK_TYPE=tcp\nTCP_IP=h\nMB_SLAVE_ID=1\n"
+      "FIRST_ELEMENT=0\nNELEMENTS=1\n"
+      "MB_TX_CODE=fnct_03_read_holding_registers\n")
+BAD += [
+    ("TOTAL_TRANSACTIONS=1\nTOTAL_TRANSACTIONS=2\n", "TOTAL_TRANSACTIONS",
+     2, "key repeated (first at line 2)"),
+    ("TOTAL_TRANSACTIONS=1\n[TRANSACTION_00]\nLINK_TYPE=tcp\n"
+     "TCP_PORT=15999\nTCP_PORT=70000\n", "[TRANSACTION_00]TCP_PORT", 5,
+     "key repeated (first at line 5)"),
+    ("TOTAL_TRANSACTIONS=1\n" + TX + "MB_SLAVEID=3\n",
+     "[TRANSACTION_00]MB_SLAVEID", 9,
+     "unknown key (did you mean MB_SLAVE_ID?)"),
+    ("TOTAL_TRANSACTION=1\n", "[MB2HAL_INIT]TOTAL_TRANSACTION", 1,
+     "unknown key"),
+    ("TOTAL_TRANSACTIONS=1\n" + TX + TX, "[TRANSACTION_00]", 9,
+     "section repeated (first at line 3)"),
+    ("TOTAL_TRANSACTIONS=1\n" + TX + "[MB2HAL_INIT]\nSLOWDOWN=1\n",
+     "[MB2HAL_INIT]", 9, "section repeated (first at line 1)"),
+    ("SLOWDOWN=1e300\nTOTAL_TRANSACTIONS=1\n", "SLOWDOWN", 1,
+     "must be from 0 to 60 seconds"),
+    ("SLOWDOWN=nan\nTOTAL_TRANSACTIONS=1\n", "SLOWDOWN", 1, "must be"),
+    ("SLOWDOWN=inf\nTOTAL_TRANSACTIONS=1\n", "SLOWDOWN", 1, "must be"),
+    ("SLOWDOWN=-1\nTOTAL_TRANSACTIONS=1\n", "SLOWDOWN", 1, "must be"),
+    ("TOTAL_TRANSACTIONS=1\n" + TX + "MAX_UPDATE_RATE=nan\n",
+     "MAX_UPDATE_RATE", 9, "must be 0 (no limit) or from 1/3600"),
+    ("TOTAL_TRANSACTIONS=1\n" + TX + "MAX_UPDATE_RATE=inf\n",
+     "MAX_UPDATE_RATE", 9, "must be 0"),
+    ("TOTAL_TRANSACTIONS=1\n" + TX + "MAX_UPDATE_RATE=1e-300\n",
+     "MAX_UPDATE_RATE", 9, "must be 0"),
+    ("TOTAL_TRANSACTIONS=1\n" + TX + "MB_RESPONSE_TIMEOUT_MS=60001\n",
+     "MB_RESPONSE_TIMEOUT_MS", 9, "out of range 1..60000"),
+]
+
+
 @pytest.mark.parametrize("body,key,line,text", BAD)
 def test_bad_ini_names_file_line_and_key(tmp_path, body, key, line, text):
     path = tmp_path / "bad.ini"
@@ -327,6 +462,28 @@ def test_bad_ini_names_file_line_and_key(tmp_path, body, key, line, text):
     msg = str(err.value)
     assert msg.startswith(f"{path}:{line + 1}: " if line else f"{path}:1: ")
     assert key in msg and text in msg
+
+
+def test_every_key_of_the_reference_example_is_known(tmp_path):
+    """The reference's example file sets serial keys in a tcp transaction
+    and every optional key; all of them must be accepted."""
+    path = tmp_path / "full.ini"
+    path.write_text(
+        "# comment\n[MB2HAL_INIT]\nINIT_DEBUG=3\nVERSION=1.1\n"
+        "HAL_MODULE_NAME=mb2hal\nSLOWDOWN=0.0\nTOTAL_TRANSACTIONS=2\n"
+        "[TRANSACTION_00]\nLINK_TYPE=tcp\nTCP_IP=10.0.0.2\nTCP_PORT=502\n"
+        "SERIAL_PORT=/dev/ttyS0\nSERIAL_BAUD=19200\nSERIAL_BITS=8\n"
+        "SERIAL_PARITY=none\nSERIAL_STOP=2\nSERIAL_DELAY_MS=10\n"
+        "MB_SLAVE_ID=1\nFIRST_ELEMENT=0\n#NELEMENTS=4\nPIN_NAMES=a,b\n"
+        "MB_TX_CODE=fnct_03_read_holding_registers\n"
+        "MB_RESPONSE_TIMEOUT_MS=500\nMB_BYTE_TIMEOUT_MS=500\n"
+        "HAL_TX_NAME=io\nMAX_UPDATE_RATE=0.0\nDEBUG=2\n"
+        "[TRANSACTION_01]\nMB_TX_CODE=fnct_01_read_coils\n"
+        "FIRST_ELEMENT=8\nNELEMENTS=3\nMAX_UPDATE_RATE=10.0\nDEBUG=1\n"
+        "[OTHER]\nANYTHING=1\nANYTHING=2\n")
+    cfg = load_config(str(path))
+    assert [t.name for t in cfg.transactions] == ["io", "01"]
+    assert cfg.transactions[0].link.describe() == "tcp 10.0.0.2:502"
 
 
 def test_fnct_01_needs_version_1_1(tmp_path):
@@ -395,6 +552,22 @@ def test_program_bad_config_exits_1_with_file_line(tmp_path):
     assert proc.stderr.strip() == (f"mb2hal: {path}:2: [MB2HAL_INIT]"
                                    "TOTAL_TRANSACTIONS: '0' is out of range "
                                    "1..99999")
+
+
+@pytest.mark.parametrize("args,text", [
+    (["file.ini"], "unknown argument 'file.ini'"),
+    (["--bogus", "config=x.ini"], "unrecognized arguments: --bogus"),
+    ([], "missing config=FILE.ini"),
+    (["-n", "", "config=x.ini"], "-n/--name: '' is not a HAL name"),
+])
+def test_program_usage_error_exits_1_with_one_line(tmp_path, args, text):
+    proc = subprocess.run([sys.executable, "-m", "halsdk.drivers.mb2hal",
+                           *args], cwd=tmp_path, capture_output=True,
+                          text=True, timeout=30)
+    assert proc.returncode == 1
+    lines = proc.stderr.splitlines()
+    assert len(lines) == 1 and lines[0].startswith("mb2hal: ")
+    assert text in lines[0]
 
 
 @pytest.fixture

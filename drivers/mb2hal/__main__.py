@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import logging
+import re
 import sys
 from collections.abc import Sequence
 from typing import Optional
@@ -16,8 +17,17 @@ LEVELS = {0: logging.CRITICAL + 1, 1: logging.WARNING, 2: logging.INFO,
           3: logging.DEBUG, 4: logging.DEBUG}
 
 
+class _Parser(argparse.ArgumentParser):
+    """Usage errors give one line and exit status 1, as bad configs do."""
+
+    def error(self, message: str):  # type: ignore[override]
+        print(f"{self.prog}: {message} (see {self.prog} --help)",
+              file=sys.stderr)
+        sys.exit(1)
+
+
 def _args(argv: Sequence[str]) -> argparse.Namespace:
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="mb2hal", description="Modbus (TCP/RTU) to HAL component.")
     parser.add_argument("-n", "--name", help="component name (overrides "
                         "HAL_MODULE_NAME)")
@@ -31,6 +41,9 @@ def _args(argv: Sequence[str]) -> argparse.Namespace:
         args.config = value
     if args.config is None:
         parser.error("missing config=FILE.ini")
+    if args.name is not None and not re.fullmatch(r"[A-Za-z0-9_.\-]+",
+                                                  args.name):
+        parser.error(f"-n/--name: '{args.name}' is not a HAL name")
     return args
 
 

@@ -4,6 +4,7 @@ bounded time for every request."""
 from __future__ import annotations
 
 import logging
+import re
 from collections.abc import Sequence
 from typing import Any, Optional
 
@@ -115,8 +116,12 @@ class ModbusLink:
                                          **kw)
         except ModbusException as exc:
             raise LinkDown(f"{self.link.describe()}: {_short(exc)}") from None
-        except (OSError, ValueError) as exc:
-            raise LinkDown(f"{self.link.describe()}: {exc}") from None
+        except OSError as exc:
+            text = (exc.strerror or str(exc) or type(exc).__name__).lower()
+            raise LinkDown(f"{self.link.describe()}: {text}") from None
+        except ValueError as exc:
+            raise LinkDown(f"{self.link.describe()}: bad response: "
+                           f"{_short(exc)}") from None
         if resp is None:
             raise LinkDown(f"{self.link.describe()}: no response")
         if resp.isError():
@@ -136,7 +141,16 @@ class ModbusLink:
 
 
 def _short(exc: Exception) -> str:
-    text = str(exc).strip() or type(exc).__name__
-    if "No response received" in text or "TimeoutError" in text:
+    """A short, stable text for a pymodbus error (no addresses, byte
+    counts or timings, so that one problem always reads the same)."""
+    text = " ".join(str(exc).split()) or type(exc).__name__
+    low = text.lower()
+    if ("no response received" in low or "timeouterror" in low
+            or "timed out" in low):
         return "timeout, no response"
-    return text.splitlines()[0][:160]
+    if "unexpectedly closed" in low or "connection closed" in low:
+        return "connection closed by the device"
+    text = re.sub(r"^Modbus Error:\s*", "", text)
+    text = re.sub(r"^\[[^\]]*\]\s*", "", text)
+    text = re.sub(r"^Modbus\w*Client\s+\S+\s*", "", text)
+    return text[:100] or type(exc).__name__

@@ -5,6 +5,8 @@ Every problem raises :class:`ConfigError` with ``file:line`` and the key.
 
 from __future__ import annotations
 
+import difflib
+import math
 import re
 from dataclasses import dataclass, field
 from typing import Callable, Optional, TypeVar
@@ -30,6 +32,23 @@ MAX_ELEMENTS = {1: 2000, 2: 2000, 3: 125, 4: 125, 5: 1, 6: 1, 15: 1968,
 VERSION_1_1 = 1001
 PARITIES = {"none": "N", "even": "E", "odd": "O"}
 MAX_TX_NAME = 28
+#: longest SLOWDOWN, s; longest request timeout, ms; longest serial pause, ms
+MAX_SLOWDOWN = 60.0
+MAX_TIMEOUT_MS = 60_000
+MAX_DELAY_MS = 3_600_000
+#: slowest MAX_UPDATE_RATE other than 0 (once an hour) and the fastest, Hz
+MIN_RATE = 1.0 / 3600.0
+MAX_RATE = 1_000_000.0
+
+INIT_KEYS = ("INIT_DEBUG", "VERSION", "HAL_MODULE_NAME", "SLOWDOWN",
+             "TOTAL_TRANSACTIONS")
+TRANSACTION_KEYS = (
+    "LINK_TYPE", "TCP_IP", "TCP_PORT", "SERIAL_PORT", "SERIAL_BAUD",
+    "SERIAL_BITS", "SERIAL_PARITY", "SERIAL_STOP", "SERIAL_DELAY_MS",
+    "MB_SLAVE_ID", "FIRST_ELEMENT", "NELEMENTS", "PIN_NAMES", "MB_TX_CODE",
+    "MB_RESPONSE_TIMEOUT_MS", "MB_BYTE_TIMEOUT_MS", "HAL_TX_NAME",
+    "MAX_UPDATE_RATE", "DEBUG")
+TRANSACTION_SECTION = re.compile(r"TRANSACTION_\d+")
 
 T = TypeVar("T")
 
@@ -152,10 +171,10 @@ class _Reader:
                           lambda v: low <= v <= high,
                           f"is out of range {low}..{high}")
 
-    def real(self, section: str, key: str, default: float) -> float:
+    def real(self, section: str, key: str, default: float,
+             check: Callable[[float], bool], rule: str) -> float:
         value = self.typed(section, key, float, "a number", default,
-                           lambda v: 0.0 <= v < float("inf"),
-                           "must be 0 or more")
+                           lambda v: math.isfinite(v) and check(v), rule)
         assert value is not None
         return value
 
@@ -281,15 +300,18 @@ def _transaction(reader: _Reader, cfg: Config, number: int,
         function=function, pin_names=names, name=name,
         response_timeout_ms=reader.integer(
             sec, "MB_RESPONSE_TIMEOUT_MS", inherit.response_timeout_ms, 1,
-            3_600_000),
+            MAX_TIMEOUT_MS),
         byte_timeout_ms=reader.integer(
             sec, "MB_BYTE_TIMEOUT_MS", inherit.byte_timeout_ms, 0,
-            3_600_000),
-        max_update_rate=reader.real(sec, "MAX_UPDATE_RATE",
-                                    inherit.max_update_rate),
+            MAX_TIMEOUT_MS),
+        max_update_rate=reader.real(
+            sec, "MAX_UPDATE_RATE", inherit.max_update_rate,
+            lambda v: v == 0.0 or MIN_RATE <= v <= MAX_RATE,
+            f"must be 0 (no limit) or from 1/3600 (once an hour) to "
+            f"{MAX_RATE:.0f} Hz"),
         serial_delay_ms=reader.integer(sec, "SERIAL_DELAY_MS",
                                        inherit.serial_delay_ms, 0,
-                                       3_600_000),
+                                       MAX_DELAY_MS),
         debug=reader.integer(sec, "DEBUG", inherit.debug, 0, 4),
         line=reader.ini.where(sec))
     return tx
@@ -301,13 +323,16 @@ def parse(ini: IniFile) -> Config:
     cfg = Config(path=ini.path)
     if not ini.has_section(INIT):
         raise ConfigError(f"{ini.path}: section [{INIT}] is missing")
+    _check_layout(ini)
     cfg.init_debug = reader.integer(INIT, "INIT_DEBUG", 1, 0, 4)
     cfg.version = _version(reader)
     cfg.module_name = reader.raw(INIT, "HAL_MODULE_NAME") or "mb2hal"
     if not re.fullmatch(r"[A-Za-z0-9_.\-]+", cfg.module_name):
         raise reader.fail(INIT, "HAL_MODULE_NAME",
                           f"'{cfg.module_name}' is not a HAL name")
-    cfg.slowdown = reader.real(INIT, "SLOWDOWN", 0.0)
+    cfg.slowdown = reader.real(
+        INIT, "SLOWDOWN", 0.0, lambda v: 0.0 <= v <= MAX_SLOWDOWN,
+        f"must be from 0 to {MAX_SLOWDOWN:g} seconds")
     total = reader.required(INIT, "TOTAL_TRANSACTIONS", reader.integer(
         INIT, "TOTAL_TRANSACTIONS", None, 1, 99999))
     prev: Optional[Transaction] = None
@@ -323,6 +348,54 @@ def parse(ini: IniFile) -> Config:
                                   "is configured twice with different "
                                   "settings")
     return cfg
+
+
+def _ours(section: str) -> bool:
+    return section == INIT or bool(TRANSACTION_SECTION.fullmatch(section))
+
+
+def _section_headers(path: str) -> list[tuple[str, int]]:
+    """(name, line) of every section header, repeats included, found by
+    the same rule as :class:`IniFile`."""
+    headers = []
+    with open(path, encoding="utf-8", errors="replace") as f:
+        for number, raw in enumerate(f, 1):
+            line = raw.strip()
+            if line.startswith("[") and "]" in line:
+                headers.append((line[1:line.index("]")], number))
+    return headers
+
+
+def _check_layout(ini: IniFile) -> None:
+    """Repeated sections, repeated keys and unknown keys in the mb2hal
+    sections are errors (the reference ignores them silently); the first
+    one in the file is reported."""
+    try:
+        headers = _section_headers(ini.path)
+    except OSError:             # an IniFile built in memory: no repeats
+        headers = []
+    problems: list[tuple[int, str]] = []
+    for name, number in headers:
+        first = ini.line(name)
+        if _ours(name) and number != first:
+            problems.append((number, f"[{name}]: section repeated (first "
+                                     f"at line {first})"))
+    for (section, key), places in ini.every.items():
+        if not _ours(section):
+            continue
+        known = INIT_KEYS if section == INIT else TRANSACTION_KEYS
+        if key not in known:
+            hint = difflib.get_close_matches(key, known, 1)
+            also = f" (did you mean {hint[0]}?)" if hint else ""
+            problems.append((places[0][1],
+                             f"[{section}]{key}: unknown key{also}"))
+        elif len(places) > 1:
+            problems.append((places[1][1], f"[{section}]{key}: key "
+                                           f"repeated (first at line "
+                                           f"{places[0][1]})"))
+    if problems:
+        number, text = min(problems)
+        raise ConfigError(f"{ini.path}:{number}: {text}")
 
 
 def load_config(path: str) -> Config:

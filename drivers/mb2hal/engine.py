@@ -102,7 +102,13 @@ class LinkWorker:
         self.stop = stop
         self.retry = Backoff(backoff, backoff_max)
         self.conn = factory(link)
-        self.down_text = ""
+        #: problems logged since the last good transaction (each once)
+        self.reported: set[str] = set()
+        self.working = False
+        #: unexpected errors seen (each logged once for the whole run) and
+        #: the pause after one, which grows while they go on
+        self.crashes: set[str] = set()
+        self.crash_pause = Backoff(backoff, backoff_max)
         self.debug = max(r.tx.debug for r in runners)
         self.thread = threading.Thread(target=self.run, daemon=True,
                                        name=f"mb2hal {link.describe()}")
@@ -118,19 +124,31 @@ class LinkWorker:
                     other.count_error()
             self._down(str(exc))
             return False
-        if self.down_text and self.debug >= DEBUG_ERR:
-            log.warning("%s: connected again", self.link.describe())
-        elif self.debug >= DEBUG_OK:
-            log.info("%s: connected", self.link.describe())
-        self.down_text = ""
+        # an accepted connection is not yet a working link: recovery is
+        # only announced after a good transaction (see transact)
+        if self.debug >= DEBUG_DEBUG:
+            log.debug("%s: connected", self.link.describe())
         return True
 
-    def _down(self, text: str) -> None:
+    def _down(self, text: str) -> float:
+        """Close the connection, back off; log ``text`` once until the
+        link works again. Returns the wait before the next attempt."""
         self.conn.close()
         wait = self.retry.failed(time.monotonic())
-        if text != self.down_text and self.debug >= DEBUG_ERR:
+        if text not in self.reported and self.debug >= DEBUG_ERR:
             log.error("%s (retry in %.3g s)", text, wait)
-        self.down_text = text
+        self.reported.add(text)
+        return wait
+
+    def _recovered(self) -> None:
+        """A transaction worked: the link is up (again)."""
+        if self.reported:
+            if self.debug >= DEBUG_ERR:
+                log.warning("%s: connected again", self.link.describe())
+            self.reported.clear()
+        elif not self.working and self.debug >= DEBUG_OK:
+            log.info("%s: connected", self.link.describe())
+        self.working = True
 
     # -- one transaction -------------------------------------------------
     def transact(self, runner: TxRunner) -> None:
@@ -138,15 +156,21 @@ class LinkWorker:
         try:
             values = runner.outputs() if tx.is_write else None
             result = self.conn.execute(tx, values)
-        except Refused as exc:
+        except Refused as exc:         # the device answered: link is up
+            self._recovered()
             self._failed(runner, f"{tx.line}: transaction {tx.name}: {exc}")
             return
         except LinkDown as exc:
             self._failed(runner, f"{tx.line}: transaction {tx.name}: {exc}")
             self._down(str(exc))
             return
+        except Exception as exc:        # a bug or an unforeseen library error
+            runner.count_error()        # logged by _crashed, once
+            self._crashed(exc, f"{tx.line}: transaction {tx.name}: ")
+            return
         if not tx.is_write:
             runner.publish(result)
+        self._recovered()
         runner.ok_count += 1
         self.retry.succeeded()
         if runner.failing and tx.debug >= DEBUG_ERR:
@@ -167,10 +191,35 @@ class LinkWorker:
     def run(self) -> None:
         try:
             while not self.stop.is_set():
-                if not self.cycle():
-                    self._idle()
+                try:
+                    if not self.cycle():
+                        self._idle()
+                except Exception as exc:
+                    self._crashed_outside(exc)
         finally:
             self.conn.close()
+
+    def _crashed(self, exc: Exception, where: str = "") -> None:
+        """An unexpected error: log it once, close the connection and
+        pause (0.1 s, doubling while it goes on), so that the link never
+        dies silently nor floods the log."""
+        text = where + _internal(self.link, exc)
+        if text not in self.crashes and self.debug >= DEBUG_ERR:
+            log.error("%s (logged once)", text)
+            log.debug("%s", text, exc_info=True)
+        self.crashes.add(text)
+        self.conn.close()
+        self.stop.wait(self.crash_pause.failed(time.monotonic()))
+
+    def _crashed_outside(self, exc: Exception) -> None:
+        """An unexpected error between transactions counts one error on
+        every transaction of the link."""
+        for runner in self.runners:
+            try:
+                runner.count_error()
+            except Exception:           # e.g. the component is gone
+                pass
+        self._crashed(exc)
 
     def cycle(self) -> bool:
         """Run every due transaction once; False when none was run."""
@@ -200,6 +249,15 @@ class LinkWorker:
             wake = max(wake, self.retry.next_attempt)
         wait = wake - time.monotonic()
         self.stop.wait(min(max(wait, 0.0005), 0.1))
+
+
+def _internal(link: Link, exc: Exception) -> str:
+    """One line for an unexpected exception on ``link``."""
+    what = type(exc).__name__
+    text = " ".join(str(exc).split())[:100]
+    if text:
+        what += f": {text}"
+    return f"{link.describe()}: internal error: {what}"
 
 
 class Mb2hal:
