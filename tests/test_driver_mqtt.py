@@ -20,9 +20,11 @@ from paho.mqtt.enums import CallbackAPIVersion
 
 import halsdk
 from halsdk.drivers.mqtt import Bridge, BridgeConfig, ConfigError
+from halsdk.drivers.mqtt.__main__ import main, publisher_main
 from halsdk.drivers.mqtt.bridge import FAULT_CONNECT, FAULT_REFUSED
 from halsdk.drivers.mqtt.broker import Mosquitto, find_mosquitto, free_port
 from halsdk.drivers.mqtt.config import Subscription, parse_args
+from halsdk.drivers.mqtt.payload import MAX_PAYLOAD, PayloadError, parse
 
 PREFIX = "t/bridge"
 
@@ -258,7 +260,9 @@ BAD = [("feed/set", b"\xff\xfe not json"), ("feed/set", b"{'value': 1}"),
        ("feed/set", b'{"type": "s32", "value": 1}'),
        ("run/set", b"2"), ("count/set", b"-1"), ("count/set", b"1.5"),
        ("count/set", b"4294967296"), ("set", b'{"nosuch": 1}'),
-       ("set", b"[1, 2]"), ("feed/set", b"1e999")]
+       ("set", b"[1, 2]"), ("feed/set", b"1e999"),
+       ("set", b"[" * 1100),                       # nested too deeply
+       ("feed/set", b" " * MAX_PAYLOAD + b"0.5")]  # valid, but too long
 
 
 def test_bad_payloads_counted_logged_once(hal, broker, bridges, listeners,
@@ -289,6 +293,15 @@ def test_bad_payloads_counted_logged_once(hal, broker, bridges, listeners,
     assert "t/bridge/count/set': -1 is out of range for u32" in text
     assert "t/bridge/set': unknown key 'nosuch'" in text
     assert not bridge.comp["fault"]
+
+
+def test_payload_depth_and_size_limits():
+    for raw, words in [(b"[" * 1100, "nested too deeply"),
+                       (b'{"value": ' + b"[" * 5000, "nested too deeply"),
+                       (b" " * MAX_PAYLOAD + b"1", f"limit of {MAX_PAYLOAD}")]:
+        with pytest.raises(PayloadError, match=words):
+            parse(raw)
+    assert parse(b" " * (MAX_PAYLOAD - 1) + b"1") == 1
 
 
 def test_broker_restart(hal, source, broker, bridges, listeners, caplog):
@@ -458,13 +471,97 @@ def test_options_and_config_file(tmp_path):
             ("\n[wrong]\n", "bad.conf:2: unknown section [wrong]"),
             ("x\n", "bad.conf:1: line outside a section"),
             ("[subscribe]\na = bit\na = bit\n",
-             "bad.conf:3: pin 'a' subscribed twice (first at ")]:
+             "bad.conf:3: pin 'a' subscribed twice (first at "),
+            ("[mqtt]\nport = 15885\nport = 1\n",
+             "bad.conf:3: key 'port' given twice (first at "),
+            ("[mqtt]\npassword = a\npassword-file = bad.conf\n",
+             "bad.conf:3: key 'password-file' sets the same as 'password'"),
+            ("[mqtt]\nqos = 1\n[publish]\nsrc.x\n[mqtt]\nqos = 2\n",
+             "bad.conf:5: section [mqtt] given twice (first at "),
+            ("[publish]\nsrc.x\n[publish]\n",
+             "bad.conf:3: section [publish] given twice"),
+            ("[publish]\nsrc.x\nsignal:src.x\n",
+             "bad.conf:3: item 'src.x' published twice (first at "),
+            ("[mqtt]\npoll = 1e300\n",
+             "bad.conf:2: poll: 1e300 must be > 0 and at most 3600 s")]:
         bad = tmp_path / "bad.conf"
         bad.write_text(text)
         with pytest.raises(ConfigError) as info:
             parse_args(["-c", str(bad), "keys=x"])
         assert str(info.value).startswith(f"{bad.parent}/{message}"), \
             str(info.value)
+
+
+def test_numeric_options_are_bounded():
+    for args, message in [
+            (["--poll", "1e300"], "--poll: 1e300 must be > 0 and at most 3600"),
+            (["--poll=inf"], "--poll: inf is not a finite number"),
+            (["--poll", "nan"], "--poll: nan is not a finite number"),
+            (["--poll", "0"], "--poll: 0 must be > 0"),
+            (["--poll", "3600.5"], "--poll: 3600.5 must be > 0"),
+            (["--backoff", "inf"], "--backoff: inf is not a finite"),
+            (["--backoff-max", "1e300"], "--backoff-max: 1e300 must be"),
+            (["--period", "nan"], "--period: nan is not a finite number"),
+            (["--period", "-1"], "--period: -1 must be in 0..4294967295 s"),
+            (["--period", "1e300"], "--period: 1e300 must be in 0..")]:
+        with pytest.raises(ConfigError) as info:
+            parse_args([*args, "keys=x"])
+        assert str(info.value).startswith(f"mqtt-bridge: {message}"), \
+            str(info.value)
+    for period, message in [
+            ("5000000000", "5000000000 must be in 0..4294967295 s"),
+            ("1e300", "1e300 must be in 0..4294967295 s"),
+            ("2.5", "2.5 is not a whole number of seconds")]:
+        with pytest.raises(ConfigError, match=f"^mqtt-publisher: --period: "
+                           f"{message}"):
+            parse_args(["--period", period, "keys=x"], publisher=True)
+    cfg, _ = parse_args(["--period", "4294967295", "--poll", "3600",
+                         "--backoff", "3600", "--backoff-max", "3600",
+                         "keys=x"], publisher=True)
+    assert (cfg.period, cfg.poll, cfg.backoff_max) == (4294967295, 3600,
+                                                       3600)
+
+
+def test_errors_name_the_option_typed():
+    for option in ("--mqtt-port", "--port"):
+        for args in ([option, "70000"], [f"{option}=70000"]):
+            with pytest.raises(ConfigError) as info:
+                parse_args([*args, "keys=x"])
+            assert str(info.value) == \
+                f"mqtt-bridge: {option}: 70000 is not in 1..65535"
+    with pytest.raises(ConfigError, match="^mqtt-bridge: --keepalive: 0 "
+                       "is not in 1..65535"):
+        parse_args(["--keepalive", "0", "keys=x"])
+
+
+def test_api_config_is_checked(hal):
+    for field, value, words in [
+            ("poll", float("inf"), "poll: inf is not a finite number"),
+            ("poll", 1e300, r"poll: 1e\+300 must be > 0 and at most 3600 s"),
+            ("poll", 10 ** 400, r"poll: 10{36}\.\.\. is too large"),
+            ("backoff", float("nan"), "backoff: nan is not a finite"),
+            ("period", -1.0, "period: -1.0 must be in 0..4294967295 s"),
+            ("keepalive", 0, "keepalive: 0 is not an integer in 1..65535"),
+            ("port", 70000, "port: 70000 is not an integer in 1..65535")]:
+        cfg = BridgeConfig(publish=[("", "x")], **{field: value})
+        with pytest.raises(ConfigError, match=f"^mqtt-bridge: {words}"):
+            Bridge(cfg).start()
+    assert not hal.components("mqtt-bridge")
+
+
+def test_program_errors_start_with_its_name(tmp_path, capsys):
+    missing = tmp_path / "nonexist.ini"
+    assert main(["-c", str(missing)]) == 1
+    assert capsys.readouterr().err == (
+        f"mqtt-bridge: {missing}: cannot read: No such file or directory\n")
+    conf = tmp_path / "q1.ini"
+    conf.write_text("[mqtt]\nqos = 1\nfoo = 2\n")
+    assert publisher_main(["-c", str(conf), "keys=x"]) == 1
+    assert capsys.readouterr().err == (
+        f"mqtt-publisher: {conf}:3: unknown key 'foo'\n")
+    assert main(["--mqtt-port", "70000", "keys=x"]) == 1
+    assert capsys.readouterr().err == (
+        "mqtt-bridge: --mqtt-port: 70000 is not in 1..65535\n")
 
 
 def test_example_config_parses():
@@ -558,7 +655,9 @@ def test_program_dryrun_and_bad_options(hal, source, tmp_path,
             (["keys=no.such.pin"], "key 'no.such.pin': no pin, param or "
              "signal of that name"),
             (["--mqtt-port=x", "keys=src.x"], "port: not a number: 'x'"),
-            (["-c", "missing.conf"], "missing.conf: cannot read"),
+            (["-c", "missing.conf"], "mqtt-bridge: missing.conf: cannot "
+             "read"),
+            (["--poll", "1e300", "keys=src.x"], "mqtt-bridge: --poll: 1e300"),
             (["src.x"], "unexpected argument 'src.x'")]:
         bad = subprocess.run(["mqtt-bridge", *args], cwd=tmp_path,
                              capture_output=True, text=True, timeout=20)

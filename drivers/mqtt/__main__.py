@@ -13,13 +13,19 @@ from halsdk.drivers.mqtt.config import ConfigError, parse_args
 from halsdk.errors import HalError
 
 
+def _named(prog: str, exc: Exception) -> str:
+    """The error as one line that starts with the program's name."""
+    text = str(exc).replace("\n", " ")
+    return text if text.startswith(f"{prog}: ") else f"{prog}: {text}"
+
+
 def _run(argv: Optional[Sequence[str]], publisher: bool) -> int:
     prog = "mqtt-publisher" if publisher else "mqtt-bridge"
     argv = sys.argv[1:] if argv is None else argv
     try:
         cfg, verbose = parse_args(argv, publisher)
     except ConfigError as exc:
-        print(exc, file=sys.stderr)
+        print(_named(prog, exc), file=sys.stderr)
         return 1
     logging.basicConfig(level=logging.INFO if verbose else logging.WARNING,
                         format="%(message)s")
@@ -27,8 +33,7 @@ def _run(argv: Optional[Sequence[str]], publisher: bool) -> int:
     try:
         bridge.start()
     except (ConfigError, HalError) as exc:
-        print(f"{prog}: {exc}" if isinstance(exc, HalError) else exc,
-              file=sys.stderr)
+        print(_named(prog, exc), file=sys.stderr)
         return 1
     bridge.run()
     return 0

@@ -15,7 +15,7 @@ from halsdk import _core
 from halsdk.component import Component, component
 from halsdk.drivers.mqtt import payload
 from halsdk.drivers.mqtt.client import Link
-from halsdk.drivers.mqtt.config import BridgeConfig, ConfigError, Subscription
+from halsdk.drivers.mqtt.config import BridgeConfig, ConfigError, Subscription, check
 from halsdk.errors import HalError
 
 log = logging.getLogger("halsdk.driver.mqtt")
@@ -71,6 +71,7 @@ class Bridge:
     def start(self) -> Component:
         """Create the component, resolve items, start the MQTT link."""
         cfg = self.cfg
+        check(cfg, cfg.name)
         comp = component(cfg.name, cfg.name, self._instance)
         self.comp = comp
         try:

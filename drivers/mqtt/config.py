@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import re
 from collections.abc import Sequence
@@ -90,13 +91,43 @@ KEYS = {
     "backoff-max": ("backoff_max", "positive"),
     "dryrun": ("dryrun", "bool"),
 }
+#: largest poll and reconnect delays, seconds
+MAX_WAIT = 3600.0
+#: largest batch period, seconds: the range of the publisher's u32 pin
+MAX_PERIOD = 2 ** 32 - 1
+#: kind -> (lowest, highest) for the integer kinds
+INT_LIMITS = {"int": (1, 65535), "port": (1, 65535), "qos": (0, 2)}
 TRUE = ("1", "true", "yes", "on")
 FALSE = ("0", "false", "no", "off")
 ITEM_KINDS = ("pin", "param", "signal")
 NAME_RE = re.compile(r"^[A-Za-z0-9_.\-\[\]:]+$")
 
 
-def _convert(key: str, text: str, where: str, label: str = ""):
+def _number_problem(kind: str, value: float, publisher: bool,
+                    shown: str = "") -> str:
+    """Why a number is not valid for its kind ('' when it is)."""
+    shown = shown or repr(value)
+    if len(shown) > 40:
+        shown = shown[:37] + "..."
+    try:
+        value = float(value)
+    except OverflowError:
+        return f"{shown} is too large"
+    if not math.isfinite(value):
+        return f"{shown} is not a finite number"
+    if kind == "positive" and not 0 < value <= MAX_WAIT:
+        return f"{shown} must be > 0 and at most {MAX_WAIT:g} s"
+    if kind == "seconds":
+        if not 0 <= value <= MAX_PERIOD:
+            return f"{shown} must be in 0..{MAX_PERIOD} s"
+        if publisher and not value.is_integer():
+            return (f"{shown} is not a whole number of seconds (the "
+                    "publisher's period pin is u32)")
+    return ""
+
+
+def _convert(key: str, text: str, where: str, label: str = "",
+             publisher: bool = False):
     kind = KEYS[key][1]
     label = label or key
     try:
@@ -117,19 +148,16 @@ def _convert(key: str, text: str, where: str, label: str = ""):
             if text not in ("flat", "full"):
                 raise ValueError(f"{text!r} is not 'flat' or 'full'")
             return text == "flat"
-        if kind in ("int", "port", "qos"):
+        if kind in INT_LIMITS:
             value = int(text)
-            limits = {"int": (1, 65535), "port": (1, 65535),
-                      "qos": (0, 2)}[kind]
-            if not limits[0] <= value <= limits[1]:
-                raise ValueError(f"{value} is not in {limits[0]}.."
-                                 f"{limits[1]}")
+            low, high = INT_LIMITS[kind]
+            if not low <= value <= high:
+                raise ValueError(f"{value} is not in {low}..{high}")
             return value
         value = float(text)
-        if kind == "positive" and not value > 0:
-            raise ValueError(f"{text!r} must be > 0")
-        if kind == "seconds" and not value >= 0:
-            raise ValueError(f"{text!r} must be >= 0")
+        problem = _number_problem(kind, value, publisher, text)
+        if problem:
+            raise ValueError(problem)
         return value
     except OSError as exc:
         raise ConfigError(f"{where}: {label}: cannot read {text!r}: "
@@ -184,6 +212,9 @@ def read_file(path: str, cfg: BridgeConfig) -> None:
     except UnicodeDecodeError:
         raise ConfigError(f"{path}: not a UTF-8 text file") from None
     section = ""
+    sections: dict[str, str] = {}     # section -> where it starts
+    keys: dict[str, tuple[str, str]] = {}   # attribute -> (key, where)
+    published: dict[str, str] = {}          # item name -> where
     for num, line in enumerate(lines, 1):
         where = f"{path}:{num}"
         text = line.split("#", 1)[0].strip()
@@ -196,9 +227,18 @@ def read_file(path: str, cfg: BridgeConfig) -> None:
             if section not in ("mqtt", "publish", "subscribe"):
                 raise ConfigError(f"{where}: unknown section [{section}] "
                                   "(expected mqtt, publish or subscribe)")
+            if section in sections:
+                raise ConfigError(f"{where}: section [{section}] given "
+                                  f"twice (first at {sections[section]})")
+            sections[section] = where
             continue
         if section == "publish":
-            cfg.publish.append(parse_item(text, where))
+            kind, name = parse_item(text, where)
+            if name in published:
+                raise ConfigError(f"{where}: item {name!r} published "
+                                  f"twice (first at {published[name]})")
+            published[name] = where
+            cfg.publish.append((kind, name))
         elif section == "subscribe":
             pin, sep, rest = text.partition("=")
             if not sep:
@@ -213,9 +253,27 @@ def read_file(path: str, cfg: BridgeConfig) -> None:
                 raise ConfigError(f"{where}: expected KEY = VALUE")
             if key not in KEYS:
                 raise ConfigError(f"{where}: unknown key {key!r}")
-            setattr(cfg, KEYS[key][0], _convert(key, value, where))
+            attr = KEYS[key][0]
+            if attr in keys:
+                first, at = keys[attr]
+                same = "given twice" if first == key else \
+                    f"sets the same as {first!r}"
+                raise ConfigError(f"{where}: key {key!r} {same} (first at "
+                                  f"{at})")
+            keys[attr] = (key, where)
+            setattr(cfg, attr, _convert(key, value, where,
+                                        publisher=cfg.publisher))
         else:
             raise ConfigError(f"{where}: line outside a section")
+
+
+class _Typed(argparse.Action):
+    """Stores the value and remembers the option as the user typed it."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        setattr(namespace, self.dest, values)
+        typed = namespace.__dict__.setdefault("typed_options", {})
+        typed[self.dest] = option_string
 
 
 class _Parser(argparse.ArgumentParser):
@@ -227,7 +285,11 @@ def _parser(prog: str) -> argparse.ArgumentParser:
     p = _Parser(prog=prog, add_help=True, description=(
         "Publish HAL pins, params and signals to an MQTT broker as JSON"
         " and drive pins from subscribed topics."))
-    add = p.add_argument
+
+    def add(*names: str, **kw) -> None:
+        if names[0].startswith("-") and "action" not in kw:
+            kw["action"] = _Typed
+        p.add_argument(*names, **kw)
     add("-n", "--name", help="component name (and pin prefix)")
     add("-c", "--config", help="config file ([mqtt], [publish], "
         "[subscribe])")
@@ -283,12 +345,13 @@ def parse_args(argv: Sequence[str], publisher: bool = False
         cfg.period = 10.0
     if args.config:
         read_file(args.config, cfg)
+    typed = getattr(args, "typed_options", {})
     for key, (attr, _kind) in KEYS.items():
-        value = getattr(args, key.replace("-", "_"), None)
-        if key == "batch-format":
-            value = args.batch_format
-        if value is not None and attr in cfg.__dataclass_fields__:
-            setattr(cfg, attr, _convert(key, value, prog, f"--{key}"))
+        dest = key.replace("-", "_")
+        value = getattr(args, dest, None)
+        if value is not None:
+            label = typed.get(dest) or f"--{key}"
+            setattr(cfg, attr, _convert(key, value, prog, label, publisher))
     if args.name is not None:
         if not args.name or not NAME_RE.match(args.name):
             raise ConfigError(f"{prog}: bad component name {args.name!r}")
@@ -318,6 +381,14 @@ def check(cfg: BridgeConfig, prog: str) -> None:
         raise ConfigError(f"{prog}: --tls-key needs --tls-cert")
     if cfg.password and not cfg.user:
         raise ConfigError(f"{prog}: a password needs a user name")
+    check_numbers(cfg, prog)
+    items: dict[str, str] = {}
+    for kind, name in cfg.publish:
+        shown = f"{kind}:{name}" if kind else name
+        if name in items:
+            raise ConfigError(f"{prog}: item {shown!r} published twice "
+                              f"(also as {items[name]!r})")
+        items[name] = shown
     seen: dict[str, str] = {}
     for sub in cfg.subscribe:
         if sub.pin in seen:
@@ -329,3 +400,24 @@ def check(cfg: BridgeConfig, prog: str) -> None:
         if any(topic == cfg.sub_topic(o) for o in cfg.subscribe
                if o is not sub):
             raise ConfigError(f"{sub.where}: topic {topic!r} used twice")
+
+
+def check_numbers(cfg: BridgeConfig, prog: str) -> None:
+    """Range checks of the numeric settings (for configurations built in
+    Python rather than parsed)."""
+    for attr, kind in KEYS.values():
+        value = getattr(cfg, attr)
+        if kind in INT_LIMITS and value is not None:
+            low, high = INT_LIMITS[kind]
+            if isinstance(value, bool) or not isinstance(value, int) or \
+                    not low <= value <= high:
+                raise ConfigError(f"{prog}: {attr}: {value!r} is not an "
+                                  f"integer in {low}..{high}")
+        elif kind in ("positive", "seconds"):
+            if isinstance(value, bool) or \
+                    not isinstance(value, (int, float)):
+                raise ConfigError(f"{prog}: {attr}: {value!r} is not a "
+                                  "number")
+            problem = _number_problem(kind, value, cfg.publisher)
+            if problem:
+                raise ConfigError(f"{prog}: {attr}: {problem}")

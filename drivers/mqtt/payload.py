@@ -12,6 +12,8 @@ Value = Union[bool, int, float]
 INT_RANGES = {"s32": (-(2 ** 31), 2 ** 31 - 1), "u32": (0, 2 ** 32 - 1),
               "s64": (-(2 ** 63), 2 ** 63 - 1), "u64": (0, 2 ** 64 - 1)}
 TYPES = ("bit", "float", *INT_RANGES)
+#: largest received payload, bytes; longer ones are rejected unread
+MAX_PAYLOAD = 65536
 #: keys allowed in an object payload sent to a subscribed topic
 SINGLE_KEYS = frozenset(("value", "type", "timestamp", "name"))
 
@@ -52,14 +54,20 @@ def _reject_constant(word: str) -> None:
 
 
 def parse(raw: bytes) -> Any:
-    """Decode a payload as JSON (UTF-8)."""
+    """Decode a payload as JSON (UTF-8) of at most MAX_PAYLOAD bytes."""
+    if len(raw) > MAX_PAYLOAD:
+        raise PayloadError(f"{len(raw)} bytes, more than the limit of "
+                           f"{MAX_PAYLOAD}")
+    shown = raw[:40].decode("utf-8", "replace")
     try:
         text = raw.decode("utf-8")
         return json.loads(text, parse_constant=_reject_constant)
     except PayloadError:
         raise
-    except (UnicodeDecodeError, ValueError) as exc:
-        shown = raw[:40].decode("utf-8", "replace")
+    except RecursionError:
+        raise PayloadError(f"not JSON (nested too deeply): {shown!r}") \
+            from None
+    except (ValueError, TypeError) as exc:   # UnicodeDecodeError too
         raise PayloadError(f"not JSON ({exc.__class__.__name__}): "
                            f"{shown!r}") from None
 
@@ -108,5 +116,7 @@ def convert(value: Any, type_: str) -> Value:
 
 
 def _show(value: Any) -> str:
+    if isinstance(value, (list, dict)):      # may be nested deeply
+        return "an array" if isinstance(value, list) else "an object"
     text = json.dumps(value) if not isinstance(value, str) else repr(value)
     return text if len(text) <= 40 else text[:37] + "..."
