@@ -12,6 +12,7 @@ import signal
 import subprocess
 import sys
 import time
+from types import SimpleNamespace
 from typing import Any, Callable
 
 import paho.mqtt.client as mqtt
@@ -23,6 +24,7 @@ from halsdk.drivers.mqtt import Bridge, BridgeConfig, ConfigError
 from halsdk.drivers.mqtt.__main__ import main, publisher_main
 from halsdk.drivers.mqtt.bridge import FAULT_CONNECT, FAULT_REFUSED
 from halsdk.drivers.mqtt.broker import Mosquitto, find_mosquitto, free_port
+from halsdk.drivers.mqtt.client import MAX_PENDING
 from halsdk.drivers.mqtt.config import Subscription, parse_args
 from halsdk.drivers.mqtt.payload import MAX_PAYLOAD, PayloadError, parse
 
@@ -263,6 +265,30 @@ BAD = [("feed/set", b"\xff\xfe not json"), ("feed/set", b"{'value': 1}"),
        ("set", b"[1, 2]"), ("feed/set", b"1e999"),
        ("set", b"[" * 1100),                       # nested too deeply
        ("feed/set", b" " * MAX_PAYLOAD + b"0.5")]  # valid, but too long
+
+
+def test_a_flood_is_dropped_counted_and_logged_once(hal, broker, bridges,
+                                                   caplog):
+    bridge = bridges(broker.port, subscribe=subscribe_cfg())
+    assert connected(bridge)
+    topic = f"{PREFIX}/count/set"
+
+    def flood(n: int) -> None:      # as paho's thread delivers them
+        for i in range(n):
+            bridge.link._on_message(None, None, SimpleNamespace(
+                topic=topic, payload=str(i).encode()))
+    with caplog.at_level(logging.WARNING, "halsdk.driver.mqtt"):
+        flood(MAX_PENDING + 5)
+        assert len(bridge.link.events) == MAX_PENDING     # bounded
+        bridge.cycle()
+        bridge.cycle()              # a scan with no new drops: re-armed
+        flood(MAX_PENDING + 3)
+        bridge.cycle()
+    assert bridge.comp["dropped"] == 8
+    assert bridge.comp["received"] == 2 * MAX_PENDING
+    assert hal.getp("mqtt-bridge.count") == MAX_PENDING - 1
+    dropped = [r for r in caplog.records if "dropping" in r.getMessage()]
+    assert len(dropped) == 2           # once per burst, not per message
 
 
 def test_bad_payloads_counted_logged_once(hal, broker, bridges, listeners,

@@ -22,7 +22,8 @@ log = logging.getLogger("halsdk.driver.mqtt")
 
 #: values of the fault-code pin
 FAULT_NONE, FAULT_CONNECT, FAULT_REFUSED, FAULT_LOST = 0, 1, 2, 3
-COUNTERS = ("published", "received", "bad-payloads", "reconnects")
+COUNTERS = ("published", "received", "bad-payloads", "dropped",
+            "reconnects")
 STATUS_PINS = ("connected", "fault", "fault-code", "lastpublish", *COUNTERS)
 U32 = 0xFFFFFFFF
 
@@ -64,6 +65,8 @@ class Bridge:
         self.ever_up = False
         self.fault_text = ""
         self._bad_logged: set[str] = set()
+        self._dropped_seen = 0
+        self._dropping = False
         self._next_batch = 0.0
         self._stop = threading.Event()
 
@@ -134,6 +137,7 @@ class Bridge:
             events = self.link.events
             while events:
                 self._event(events.popleft())
+            self._note_dropped(self.link.dropped)
         if not comp["enable"]:
             for item in self.items:
                 item.sent = False
@@ -177,6 +181,20 @@ class Bridge:
             return False
         self._count("published")
         return True
+
+    def _note_dropped(self, dropped: int) -> None:
+        """Publish the count of messages dropped for arriving faster than
+        the scans apply them; say so once per burst."""
+        if dropped == self._dropped_seen:
+            self._dropping = False          # a scan without new drops
+            return
+        if not self._dropping:
+            log.warning("%s: messages arrive faster than they are applied; "
+                        "dropping some (see %s.dropped)", self.cfg.name,
+                        self.cfg.name)
+            self._dropping = True
+        self._dropped_seen = dropped
+        self.comp["dropped"] = dropped & U32
 
     def _count(self, pin: str) -> None:
         self.comp[pin] = (self.comp[pin] + 1) & U32

@@ -32,6 +32,10 @@ class _Client(mqtt.Client):
             raise
 
 
+#: received messages waiting for the HAL side; more are dropped (counted)
+MAX_PENDING = 10000
+
+
 class Link:
     """One MQTT connection.  Nothing here blocks the caller: the connection
     is made and remade (with doubling delays) by paho's network thread;
@@ -43,6 +47,7 @@ class Link:
         self.topics = topics
         self.status_topic = status_topic
         self.events: collections.deque[Event] = collections.deque()
+        self.dropped = 0          # messages over MAX_PENDING, never applied
         self.up = False           # written by the network thread only
         self._refused = False
         client = _Client(CallbackAPIVersion.VERSION2,
@@ -106,6 +111,10 @@ class Link:
         self._refused = False
 
     def _on_message(self, client, userdata, message):
+        # a flood of messages must not grow memory without end
+        if len(self.events) >= MAX_PENDING:
+            self.dropped += 1
+            return
         self.events.append(("msg", message.topic, message.payload))
 
     # -- HAL side ----------------------------------------------------------
