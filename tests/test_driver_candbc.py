@@ -457,3 +457,93 @@ def test_example_hal_file_with_loadusr_w(tmp_path, python_tools_first):
     assert lines[:2] == ["TRUE", "TRUE"]
     assert int(lines[2]) > 0                            # sent cyclically
     assert "can-dbc" not in "\n".join(lines[3:])         # unloaded
+
+
+# -- bad input (review findings) -----------------------------------------------
+class NoLoop:
+    """Stands in for IOLoop: an accepted command line returns at once."""
+
+    def __init__(self, driver, period: float) -> None:
+        self.driver = driver
+
+    def run(self) -> None:
+        pass
+
+
+def run_main(args: list[str], capsys) -> tuple[int, str]:
+    from halsdk.drivers.candbc import __main__ as program
+    mp = pytest.MonkeyPatch()
+    mp.setattr(program, "IOLoop", NoLoop)
+    try:
+        code = program.main(args)
+    finally:
+        mp.undo()
+    return code, capsys.readouterr().err
+
+
+@pytest.mark.parametrize("args, text", [
+    (["--loop-period", "1e300"], "--loop-period: '1e300': expected seconds"),
+    (["--loop-period", "inf"], "--loop-period: 'inf'"),
+    (["--loop-period", "nan"], "--loop-period: 'nan'"),
+    (["--loop-period", "5"], "at most 1"),
+    (["--timeout-factor", "inf"], "--timeout-factor: 'inf'"),
+    (["--period", "1e300"], "--period '1e300': expected seconds from 0"),
+    (["--timeout", "DriveStatus=1e9"], "--timeout '1e9'"),
+    (["--num", "99999999999"], "--num: '99999999999': expected 0 to 999"),
+    (["--num", "-1"], "--num: '-1'"),
+    (["--bitrate", "-5"], "--bitrate: '-5': expected bit/s"),
+    (["--bitrate", "0"], "--bitrate: '0'"),
+    (["-n", ""], "-n/--name: the component name is empty"),
+    (["--bogus"], "unrecognized arguments: --bogus"),
+])
+def test_bad_options_one_line_status_1(args, text, hal, capsys):
+    code, err = run_main(["--dbc", DEMO, "--interface", "virtual", *args],
+                         capsys)
+    assert code == 1
+    assert err.startswith("can-dbc: ") and text in err, err
+    assert len(err.splitlines()) == 1
+
+
+def test_unknown_option_named_before_missing_dbc(hal, capsys):
+    code, err = run_main(["--bogus"], capsys)
+    assert (code, err) == (1, "can-dbc: unrecognized arguments: --bogus\n")
+    code, err = run_main([], capsys)
+    assert code == 1 and "required: --dbc" in err
+
+
+def test_truncated_empty_and_bad_cycle_dbc(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    text = open(DEMO, encoding="cp1252").read()
+    cut = text.index(" SG_ InfoPage") + len(" SG_ InfoPag")
+    (tmp_path / "cut.dbc").write_text(text[:cut])
+    line = text[:cut].count("\n") + 1
+    with pytest.raises(ConfigError) as info:
+        parse_args(["--dbc", "cut.dbc"])
+    assert str(info.value) == (f"cut.dbc:{line}: incomplete statement at "
+                               "the end of the file (truncated?)")
+    # cut inside a signal's numbers: the earlier signals must not pass
+    cut = text.index("RunHours m1 : 8|24")
+    (tmp_path / "cut2.dbc").write_text(text[:cut + 12])
+    with pytest.raises(ConfigError, match=r"^cut2.dbc:\d+: incomplete"):
+        parse_args(["--dbc", "cut2.dbc"])
+    (tmp_path / "empty.dbc").write_text("\n  \n// nothing\n")
+    with pytest.raises(ConfigError, match=r"^empty.dbc: empty DBC file$"):
+        parse_args(["--dbc", "empty.dbc"])
+    (tmp_path / "slow.dbc").write_text(text.replace(
+        'BO_ 512 50;', 'BO_ 512 99999999999;'))
+    with pytest.raises(ConfigError, match=r"^slow.dbc:17: message "
+                       "DriveCommand: cycle time 99999999999 ms"):
+        parse_args(["--dbc", "slow.dbc"])
+    # the whole file still loads, with every signal
+    config = parse_args(["--dbc", DEMO])
+    info_msg = config.db.get_message_by_name("DriveInfo")
+    assert len(info_msg.signals) == 3
+
+
+def test_errors_name_the_dbc_as_given(tmp_path, monkeypatch, hal, capsys):
+    monkeypatch.chdir(tmp_path)                  # demo.dbc: the shipped one
+    for args, text in (
+            (["--node", "Nope"], "demo.dbc: no node named 'Nope' (--node)"),
+            (["--tx", "Nope"], "demo.dbc: no message named 'Nope' (--tx)")):
+        code, err = run_main(["--dbc", "demo.dbc", *args], capsys)
+        assert (code, err) == (1, f"can-dbc: {text}\n")

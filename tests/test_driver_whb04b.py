@@ -367,3 +367,59 @@ def test_program_without_device_faults_and_stops(hal, tmp_path):
     lines = err.strip().splitlines()
     assert len(lines) == 1 and "whb04b.0: open failed: " in lines[0], err
     assert "Traceback" not in err
+
+
+# ------------------------------------------------- bad input (review findings)
+
+@pytest.mark.parametrize("line, text", [
+    ("pause 1e300", "1: 'pause' needs one number of seconds from 0 to 3600"),
+    ("pause inf", "1: 'pause' needs"),
+    ("pause nan", "1: 'pause' needs"),
+    ("pause 3601", "1: 'pause' needs"),
+    ("05 2", "1: hex bytes are two digits each, not '2'"),
+    ("04 011", "1: hex bytes are two digits each, not '011'"),
+    ("04 -1", "1: expected hex bytes"),
+])
+def test_replay_line_limits(line, text):
+    with pytest.raises(ScriptError) as info:
+        parse_script([line], "s.txt")
+    assert str(info.value).startswith(f"s.txt:{text}")
+
+
+def test_replay_limits_accept_the_edges():
+    steps = parse_script(["pause 3600", "0A ff 00"])
+    assert steps[0].seconds == 3600 and steps[1].data == b"\x0a\xff\x00"
+
+
+def test_unreadable_replay_names_file_once(tmp_path):
+    with pytest.raises(ScriptError) as info:
+        load_script(tmp_path / "nosuch.txt")
+    assert str(info.value) == (f"{tmp_path / 'nosuch.txt'}: cannot read: "
+                               "No such file or directory")
+
+
+@pytest.mark.parametrize("args, text", [
+    (["--period", "1e300"], "argument --period: '1e300': expected seconds"),
+    (["--period", "inf"], "argument --period: 'inf'"),
+    (["--period", "-1"], "argument --period: '-1'"),
+    (["--period", "2"], "at most 1"),
+    (["--bogus"], "unrecognized arguments: --bogus"),
+    (["--product-id", "zz"], "not a hex number"),
+    (["-n", ""], "the component name is empty"),
+    (["--replay", str(DATA / "long-pause.txt")], "long-pause.txt:2: 'pause'"),
+])
+def test_bad_command_line_one_line_status_1(args, text, hal, capsys,
+                                            monkeypatch):
+    from halsdk.drivers.whb04b import __main__ as program
+
+    class NoLoop:                    # an accepted command line returns
+        def __init__(self, driver, period: float) -> None:
+            pass
+
+        def run(self) -> None:
+            pass
+    monkeypatch.setattr(program, "IOLoop", NoLoop)
+    assert program.main(args) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("whb04b: ") and text in err, err
+    assert len(err.splitlines()) == 1

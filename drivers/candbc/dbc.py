@@ -20,7 +20,7 @@ class ConfigError(Exception):
     """A bad command line or DBC file; the message names file:line."""
 
 
-def _line_of_message(path: str, error: str) -> Optional[int]:
+def line_of_message(path: str, error: str) -> Optional[int]:
     """The line of the ``BO_`` definition of the first message named in
     ``error`` (semantic errors from cantools name a message, not a line)."""
     try:
@@ -39,29 +39,55 @@ def _line_of_message(path: str, error: str) -> Optional[int]:
     return best[1] if best else None
 
 
-def load_dbc(path: str) -> Database:
+#: appended to the text so that a statement cut off at the end of the
+#: file fails to parse (cantools accepts one that reaches the end)
+_SENTINEL = "\nBS_:\n"
+_EMPTY_LINE = re.compile(r"^\s*(//.*)?$")
+
+
+def load_dbc(path: str, shown: Optional[str] = None) -> Database:
     """Load ``path`` as a DBC file; any problem raises :class:`ConfigError`
-    with ``path:line:`` (line 1 when no better position is known)."""
+    with ``shown:line:`` (``shown`` is the name the user gave, default
+    ``path``; line 1 when no better position is known)."""
+    shown = path if shown is None else shown
     try:
-        return cantools.database.load_file(path, database_format="dbc")
+        with open(path, encoding="cp1252") as f:
+            text = f.read()
     except OSError as exc:
-        raise ConfigError(f"{path}: cannot read: {exc.strerror or exc}"
+        raise ConfigError(f"{shown}: cannot read: {exc.strerror or exc}"
                           ) from None
+    lines = text.splitlines()
+    if all(_EMPTY_LINE.match(line) for line in lines):
+        raise ConfigError(f"{shown}: empty DBC file")
+    try:
+        return cantools.database.load_string(text + _SENTINEL,
+                                             database_format="dbc")
     except Exception as exc:     # cantools raises several kinds
-        inner = getattr(exc, "e_dbc", None) or exc
-        line = getattr(inner, "line", None)
-        if line is not None:
-            column = getattr(inner, "column", None)
-            where = f"{line}:{column}" if column else f"{line}"
-            text = str(inner)
-            text = re.sub(r"^Invalid syntax at line \d+, column \d+: ",
-                          "invalid syntax: ", text)
-            raise ConfigError(f"{path}:{where}: {text}") from None
-        text = str(inner).strip('"')
-        if text.startswith("DBC: "):
-            text = text[5:].strip('"')
-        line = _line_of_message(path, text) or 1
-        raise ConfigError(f"{path}:{line}: {text}") from None
+        raise ConfigError(_error_text(exc, path, shown, lines)) from None
+
+
+def _error_text(exc: Exception, path: str, shown: str,
+                lines: list[str]) -> str:
+    """``shown:line[:column]: text`` for a cantools load error."""
+    inner = getattr(exc, "e_dbc", None) or exc
+    line = getattr(inner, "line", None)
+    if line is not None:
+        if line > len(lines):        # the parse ran into the sentinel
+            last = max(n for n, text in enumerate(lines, 1)
+                       if not _EMPTY_LINE.match(text))
+            return (f"{shown}:{last}: incomplete statement at the end of "
+                    "the file (truncated?)")
+        column = getattr(inner, "column", None)
+        where = f"{line}:{column}" if column else f"{line}"
+        text = str(inner)
+        text = re.sub(r"^Invalid syntax at line \d+, column \d+: ",
+                      "invalid syntax: ", text)
+        return f"{shown}:{where}: {text}"
+    text = str(inner).strip('"')
+    if text.startswith("DBC: "):
+        text = text[5:].strip('"')
+    line = line_of_message(path, text) or 1
+    return f"{shown}:{line}: {text}"
 
 
 def find_package_dbc(name: str) -> Optional[str]:

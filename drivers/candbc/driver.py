@@ -78,7 +78,8 @@ class CanDbcDriver(Driver):
         self.config = config
         self.clock = clock
         self.bus: Optional[can.BusABC] = None
-        ports = build_ports([*config.rx, *config.tx], config.dbc_path)
+        ports = build_ports([*config.rx, *config.tx],
+                            config.dbc_name or config.dbc_path)
         self.rx = ports[:len(config.rx)]
         self.tx = ports[len(config.rx):]
         for port in self.rx:

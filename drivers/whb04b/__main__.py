@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import logging
+import math
 import sys
 from collections.abc import Sequence
 from importlib import resources
@@ -15,6 +16,18 @@ from halsdk.drivers.whb04b.fake import FakeBackend, ScriptError, load_script
 from halsdk.drivers.whb04b.protocol import PRODUCT_ID
 
 DEMO = "demo"
+#: longest loop period: USB reads wait up to a quarter of it, and a stop
+#: request is seen between reads
+MAX_PERIOD = 1.0
+
+
+class UsageError(Exception):
+    """A bad command line (one line, exit status 1)."""
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str) -> None:     # type: ignore[override]
+        raise UsageError(message)
 
 
 def _hex(text: str) -> int:
@@ -28,28 +41,35 @@ def _hex(text: str) -> int:
     return value
 
 
-def _positive(text: str) -> float:
+def _period(text: str) -> float:
     try:
         value = float(text)
     except ValueError:
-        value = -1.0
-    if not value > 0:
-        raise argparse.ArgumentTypeError(f"not a positive number: {text!r}")
+        value = math.nan
+    if not (math.isfinite(value) and 0 < value <= MAX_PERIOD):
+        raise argparse.ArgumentTypeError(
+            f"{text!r}: expected seconds > 0 and at most {MAX_PERIOD:g}")
     return value
 
 
+def _name(text: str) -> str:
+    if not text.strip():
+        raise argparse.ArgumentTypeError("the component name is empty")
+    return text
+
+
 def parse_args(argv: Optional[Sequence[str]]) -> argparse.Namespace:
-    p = argparse.ArgumentParser(
+    p = _Parser(
         prog="whb04b",
         description="HAL driver for the XHC WHB04B wireless jog pendant.")
-    p.add_argument("-n", "--name", default="whb04b",
+    p.add_argument("-n", "--name", default="whb04b", type=_name,
                    help="HAL component name (default whb04b)")
     p.add_argument("--replay", metavar="FILE",
                    help="play a recorded session instead of using USB "
                         f"('{DEMO}' plays the shipped demo)")
     p.add_argument("--product-id", type=_hex, default=PRODUCT_ID,
                    metavar="HEX", help="USB product id (default eb93)")
-    p.add_argument("--period", type=_positive, default=0.02,
+    p.add_argument("--period", type=_period, default=0.02,
                    help="loop period in seconds (default 0.02)")
     p.add_argument("-v", "--verbose", action="store_true",
                    help="log reconnect attempts")
@@ -57,7 +77,11 @@ def parse_args(argv: Optional[Sequence[str]]) -> argparse.Namespace:
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
-    args = parse_args(argv)
+    try:
+        args = parse_args(argv)
+    except UsageError as exc:
+        print(f"whb04b: {exc}", file=sys.stderr)
+        return 1
     logging.basicConfig(level=logging.INFO if args.verbose
                         else logging.WARNING, format="%(message)s")
     backend = None

@@ -19,6 +19,8 @@ from __future__ import annotations
 
 import array
 import errno
+import math
+import re
 import time
 from collections import deque
 from collections.abc import Iterable
@@ -33,6 +35,9 @@ import usb.core
 from halsdk.drivers.whb04b.protocol import PRODUCT_ID, VENDOR_ID
 
 IN_ENDPOINT = 0x81
+#: longest ``pause`` of a replay file, in seconds
+MAX_PAUSE = 3600.0
+_HEX_BYTE = re.compile(r"[0-9a-fA-F]{2}")
 
 
 class ScriptError(ValueError):
@@ -63,20 +68,19 @@ def parse_script(lines: Iterable[str], source: str = "<script>"
                 seconds = float(words[1]) if len(words) == 2 else -1.0
             except ValueError:
                 seconds = -1.0
-            if not seconds >= 0:
+            if not (math.isfinite(seconds) and 0 <= seconds <= MAX_PAUSE):
                 raise ScriptError(f"{where}: 'pause' needs one number of "
-                                  "seconds >= 0")
+                                  f"seconds from 0 to {MAX_PAUSE:g}")
             steps.append(Step("pause", seconds=seconds))
         else:
-            try:
-                data = bytes(int(w, 16) for w in words)
-            except ValueError:
+            bad = [w for w in words if not _HEX_BYTE.fullmatch(w)]
+            if bad and all(re.fullmatch(r"[0-9a-fA-F]+", w) for w in bad):
+                raise ScriptError(f"{where}: hex bytes are two digits each, "
+                                  f"not {bad[0]!r}")
+            if bad:
                 raise ScriptError(f"{where}: expected hex bytes, 'pause S', "
-                                  f"'plug' or 'unplug', got {text!r}"
-                                  ) from None
-            if any(len(w) > 2 for w in words):
-                raise ScriptError(f"{where}: hex bytes are two digits each")
-            steps.append(Step("report", data=data))
+                                  f"'plug' or 'unplug', got {text!r}")
+            steps.append(Step("report", data=bytes.fromhex("".join(words))))
     return steps
 
 
@@ -84,8 +88,12 @@ def load_script(path: Union[str, Path]) -> list[Step]:
     """Read a replay file; :class:`ScriptError` when unreadable or bad."""
     try:
         text = Path(path).read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ScriptError(f"{path}: cannot read: {exc}") from None
+    except OSError as exc:
+        raise ScriptError(f"{path}: cannot read: {exc.strerror or exc}"
+                          ) from None
+    except UnicodeDecodeError as exc:
+        raise ScriptError(f"{path}: cannot read: not UTF-8 text (byte "
+                          f"{exc.start})") from None
     return parse_script(text.splitlines(), str(path))
 
 
