@@ -9,7 +9,7 @@ so that a program that finds a bad value can name the file and line.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Callable, Collection, Iterator
 from typing import Optional
 
 
@@ -23,6 +23,8 @@ class IniFile:
         #: every occurrence (repeated keys such as [HAL]HALFILE), in order
         self.every: dict[tuple[str, str], list[tuple[str, int]]] = {}
         self.section_lines: dict[str, int] = {}
+        #: every section header and its line, repeats included
+        self.headers: list[tuple[str, int]] = []
         section = ""
         with open(path, encoding="utf-8", errors="replace") as f:
             for number, raw in enumerate(f, 1):
@@ -32,6 +34,7 @@ class IniFile:
                 if line.startswith("[") and "]" in line:
                     section = line[1:line.index("]")]
                     self.section_lines.setdefault(section, number)
+                    self.headers.append((section, number))
                     continue
                 if "=" in line:
                     key, _, value = line.partition("=")
@@ -64,6 +67,28 @@ class IniFile:
         for (sec, key), value in self.values.items():
             if sec == section:
                 yield key, value
+
+    def repeats(self, sections: Callable[[str], bool] = lambda s: True,
+                repeatable: Collection[str] = ()) -> list[tuple[int, str]]:
+        """Section headers and keys given more than once in the sections
+        that ``sections`` accepts (LinuxCNC merges the sections and keeps
+        a key's first value, which hides typing mistakes), but keys in
+        ``repeatable``: ``(line, message)`` of each later occurrence, in
+        file order, such as ``[AXIS_X] is given again (first at line
+        3)``."""
+        found = []
+        for name, number in self.headers:
+            first = self.section_lines[name]
+            if number != first and sections(name):
+                found.append((number, f"[{name}] is given again (first at "
+                                      f"line {first})"))
+        for (section, key), places in self.every.items():
+            if len(places) > 1 and key not in repeatable and \
+                    sections(section):
+                for _, number in places[1:]:
+                    found.append((number, f"[{section}]{key} is given again "
+                                          f"(first at line {places[0][1]})"))
+        return sorted(found)
 
     def where(self, section: str, key: Optional[str] = None) -> str:
         """``path:line`` of an entry (or ``path`` when it is absent)."""

@@ -320,7 +320,7 @@ DRIVE = "[DRIVE_0]\nNODE_ID = 1\n"
     ("[BUS]\nPERIOD = 0.01\n" + DRIVE + "[BUS]\nPERIOD = 0.02\n", 5,
      "[BUS] is given again (first at line 1)"),
     ("[BUS]\n" + DRIVE + "NODE_ID = 2\n", 4,
-     "NODE_ID is given again in [DRIVE_0] (first at line 3)"),
+     "[DRIVE_0]NODE_ID is given again (first at line 3)"),
     ("PERIOD = 0.01\n[BUS]\n" + DRIVE, 1, "PERIOD is outside a section"),
 ])
 def test_bad_numbers_and_repeats_name_file_and_line(tmp_path, text, line,

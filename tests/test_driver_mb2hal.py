@@ -424,19 +424,19 @@ TX = ("[TRANSACTION_00]\nLINK_TYPE=tcp\nTCP_IP=h\nMB_SLAVE_ID=1\n"
       "MB_TX_CODE=fnct_03_read_holding_registers\n")
 BAD += [
     ("TOTAL_TRANSACTIONS=1\nTOTAL_TRANSACTIONS=2\n", "TOTAL_TRANSACTIONS",
-     2, "key repeated (first at line 2)"),
+     2, "is given again (first at line 2)"),
     ("TOTAL_TRANSACTIONS=1\n[TRANSACTION_00]\nLINK_TYPE=tcp\n"
      "TCP_PORT=15999\nTCP_PORT=70000\n", "[TRANSACTION_00]TCP_PORT", 5,
-     "key repeated (first at line 5)"),
+     "is given again (first at line 5)"),
     ("TOTAL_TRANSACTIONS=1\n" + TX + "MB_SLAVEID=3\n",
      "[TRANSACTION_00]MB_SLAVEID", 9,
      "unknown key (did you mean MB_SLAVE_ID?)"),
     ("TOTAL_TRANSACTION=1\n", "[MB2HAL_INIT]TOTAL_TRANSACTION", 1,
      "unknown key"),
     ("TOTAL_TRANSACTIONS=1\n" + TX + TX, "[TRANSACTION_00]", 9,
-     "section repeated (first at line 3)"),
+     "is given again (first at line 3)"),
     ("TOTAL_TRANSACTIONS=1\n" + TX + "[MB2HAL_INIT]\nSLOWDOWN=1\n",
-     "[MB2HAL_INIT]", 9, "section repeated (first at line 1)"),
+     "[MB2HAL_INIT]", 9, "is given again (first at line 1)"),
     ("SLOWDOWN=1e300\nTOTAL_TRANSACTIONS=1\n", "SLOWDOWN", 1,
      "must be from 0 to 60 seconds"),
     ("SLOWDOWN=nan\nTOTAL_TRANSACTIONS=1\n", "SLOWDOWN", 1, "must be"),

@@ -307,27 +307,10 @@ def _drive(r: _Reader, num: int, base: str) -> DriveConfig:
 def _check_repeats(ini: IniFile) -> None:
     """Reject a repeated section header, a repeated key (but ``SDO``) and
     a key before the first section; the error names the later line."""
-    problems: list[tuple[int, str]] = []
-    try:
-        with open(ini.path, encoding="utf-8", errors="replace") as f:
-            lines = f.read().splitlines()
-    except OSError as exc:
-        raise ConfigError(f"{ini.path}: cannot read: {exc.strerror}") \
-            from None
-    for number, raw in enumerate(lines, 1):
-        line = raw.strip()
-        if line.startswith("[") and "]" in line:
-            section = line[1:line.index("]")]
-            first = ini.section_lines.get(section, number)
-            if first != number:
-                problems.append((number, f"[{section}] is given again "
-                                 f"(first at line {first})"))
+    problems = ini.repeats(repeatable=REPEATABLE)
     for (section, key), found in ini.every.items():
         if section == "":
             problems.append((found[0][1], f"{key} is outside a section"))
-        elif len(found) > 1 and key not in REPEATABLE:
-            problems.append((found[1][1], f"{key} is given again in "
-                             f"[{section}] (first at line {found[0][1]})"))
     if problems:
         number, text = min(problems)
         raise ConfigError(f"{ini.path}:{number}: {text}")

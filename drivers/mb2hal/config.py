@@ -354,32 +354,11 @@ def _ours(section: str) -> bool:
     return section == INIT or bool(TRANSACTION_SECTION.fullmatch(section))
 
 
-def _section_headers(path: str) -> list[tuple[str, int]]:
-    """(name, line) of every section header, repeats included, found by
-    the same rule as :class:`IniFile`."""
-    headers = []
-    with open(path, encoding="utf-8", errors="replace") as f:
-        for number, raw in enumerate(f, 1):
-            line = raw.strip()
-            if line.startswith("[") and "]" in line:
-                headers.append((line[1:line.index("]")], number))
-    return headers
-
-
 def _check_layout(ini: IniFile) -> None:
     """Repeated sections, repeated keys and unknown keys in the mb2hal
     sections are errors (the reference ignores them silently); the first
     one in the file is reported."""
-    try:
-        headers = _section_headers(ini.path)
-    except OSError:             # an IniFile built in memory: no repeats
-        headers = []
-    problems: list[tuple[int, str]] = []
-    for name, number in headers:
-        first = ini.line(name)
-        if _ours(name) and number != first:
-            problems.append((number, f"[{name}]: section repeated (first "
-                                     f"at line {first})"))
+    problems = ini.repeats(sections=_ours)
     for (section, key), places in ini.every.items():
         if not _ours(section):
             continue
@@ -389,10 +368,6 @@ def _check_layout(ini: IniFile) -> None:
             also = f" (did you mean {hint[0]}?)" if hint else ""
             problems.append((places[0][1],
                              f"[{section}]{key}: unknown key{also}"))
-        elif len(places) > 1:
-            problems.append((places[1][1], f"[{section}]{key}: key "
-                                           f"repeated (first at line "
-                                           f"{places[0][1]})"))
     if problems:
         number, text = min(problems)
         raise ConfigError(f"{ini.path}:{number}: {text}")
