@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import contextlib
 import os
+import signal
+import subprocess
 import sys
 from collections.abc import Iterator
 
@@ -77,3 +79,21 @@ def python_tools_first(monkeypatch: pytest.MonkeyPatch) -> str:
     folder = os.path.dirname(sys.executable)
     monkeypatch.setenv("PATH", folder + os.pathsep + os.environ["PATH"])
     return folder
+
+
+@contextlib.contextmanager
+def ended_at_exit(proc: subprocess.Popen) -> Iterator[subprocess.Popen]:
+    """Kill ``proc`` when the block ends with it still running (a failed
+    assertion must not leave a driver process behind)."""
+    try:
+        yield proc
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+
+
+def sigterm(proc: subprocess.Popen, timeout: float = 10) -> tuple:
+    """Send SIGTERM and wait for the end: (stdout, stderr)."""
+    proc.send_signal(signal.SIGTERM)
+    return proc.communicate(timeout=timeout)

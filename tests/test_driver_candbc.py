@@ -7,7 +7,6 @@ import logging
 import math
 import os
 import shutil
-import signal
 import subprocess
 import sys
 import time
@@ -15,6 +14,7 @@ import time
 import can
 import cantools
 import pytest
+from conftest import ended_at_exit, sigterm
 
 from halsdk.driver import FAULT_OPEN, FAULT_READ, IOLoop
 from halsdk.drivers.candbc import (
@@ -418,18 +418,13 @@ def test_process_sends_and_stops_on_sigterm(tmp_path, hal):
          "--num", "3", "--interface", "virtual", "--channel", "own",
          "--dbc", "demo.dbc", "--node", "PLC"], cwd=str(tmp_path),
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    try:
+    with ended_at_exit(proc):
         assert wait_for(lambda: hal.pins("candbc.3.drive-command.count")
                         and hal.getp("candbc.3.drive-command.count") >= 3)
         assert hal.getp("candbc.3.connected")
         assert hal.getp("candbc.3.drive-status.timeout")   # nobody sends
         assert [c.name for c in hal.components("mycan")] == ["mycan"]
-        proc.send_signal(signal.SIGTERM)
-        out, err = proc.communicate(timeout=10)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
+        out, err = sigterm(proc, 10)
     assert proc.returncode == 0, err
     assert "Traceback" not in err
     assert not hal.pins("candbc.3.*")

@@ -12,6 +12,7 @@ import time
 from pathlib import Path
 
 import pytest
+from conftest import ended_at_exit, sigterm
 
 from halsdk.driver import FAULT_NONE, FAULT_OPEN, FAULT_READ, IOLoop
 from halsdk.drivers.whb04b import BUTTON_NAMES, FakeBackend, Whb04bDriver
@@ -320,19 +321,14 @@ def test_program_demo_sigterm_and_bad_file(hal, tmp_path):
         [sys.executable, "-m", "halsdk.drivers.whb04b", "--replay", "demo",
          "-n", "pendant"], cwd=tmp_path, stdout=subprocess.PIPE,
         stderr=subprocess.PIPE, text=True)
-    try:
+    with ended_at_exit(proc):
         assert _wait(lambda: bool(hal.pins(P + "connected"))
                      and hal.getp(P + "connected"))
         assert "pendant" in [c.name for c in hal.components()]
         assert _wait(lambda: hal.getp(P + "jog.mode-lead"))   # last report
         assert hal.getp(P + "encoder.00.count") == 16
         assert hal.getp(P + "axis.z") and not hal.getp(P + "button.fn")
-        proc.send_signal(signal.SIGTERM)
-        out, err = proc.communicate(timeout=10)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
+        out, err = sigterm(proc, 10)
     assert proc.returncode == 0, err
     assert "Traceback" not in err
     assert not hal.pins("whb04b.*")
@@ -352,17 +348,12 @@ def test_program_without_device_faults_and_stops(hal, tmp_path):
         [sys.executable, "-m", "halsdk.drivers.whb04b", "--product-id",
          "fffe"], cwd=tmp_path, stdout=subprocess.PIPE,
         stderr=subprocess.PIPE, text=True)
-    try:
+    with ended_at_exit(proc):
         assert _wait(lambda: bool(hal.pins(P + "fault-code"))
                      and hal.getp(P + "fault-code") == FAULT_OPEN)
         assert hal.getp(P + "fault") and not hal.getp(P + "connected")
         time.sleep(0.5)                      # several attempts, backed off
-        proc.send_signal(signal.SIGTERM)
-        out, err = proc.communicate(timeout=10)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
+        out, err = sigterm(proc, 10)
     assert proc.returncode == 0, err
     lines = err.strip().splitlines()
     assert len(lines) == 1 and "whb04b.0: open failed: " in lines[0], err

@@ -9,13 +9,13 @@ from __future__ import annotations
 
 import os
 import shutil
-import signal
 import subprocess
 import sys
 import time
 from pathlib import Path
 
 import pytest
+from conftest import ended_at_exit, sigterm
 
 from halsdk import _core
 from halsdk.ini import IniFile
@@ -157,19 +157,14 @@ def test_halsdk_run_and_sigterm_end_the_driver(tmp_path, python_tools_first):
                              str(ini)], cwd=str(tmp_path), env=env,
                             text=True, stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE)
-    try:
+    with ended_at_exit(proc):
         line = proc.stdout.readline()       # once the machine runs
         assert "machine running" in line, proc.stderr.read()
         drivers = [int(pid) for pid in os.listdir("/proc")
                    if pid.isdigit()
                    and is_our_driver(pid, tmp_path / "machine")]
         assert len(drivers) == 1
-        proc.send_signal(signal.SIGTERM)
-        out, err = proc.communicate(timeout=20)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
+        out, err = sigterm(proc, 20)
     assert proc.returncode == 0, err
     assert "stopped" in out
     wait_for(lambda: not alive(drivers[0]), "the driver to end")
