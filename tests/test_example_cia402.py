@@ -92,7 +92,10 @@ def test_square_on_two_cia402_drives_then_a_clean_shutdown(machine):
     # the wiring of machine.hal
     for n in DRIVES:
         assert hal.getp(f"cia402.{n}.enable") is False
-        assert hal.getp(f"cia402.{n}.state") == READY_TO_SWITCH_ON
+    # the driver is ready once its pins exist; it configures the drives
+    # over SDO in its first cycles, then they wait, switched off
+    wait_for(lambda: all(hal.getp(f"cia402.{n}.state") == READY_TO_SWITCH_ON
+                         for n in DRIVES), "the drives to be configured")
 
     m = Machine.from_launcher(machine)
     m.state(TaskState.ESTOP_RESET)
