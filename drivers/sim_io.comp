@@ -20,7 +20,7 @@ Add \\fBsim-io.\\fIN\\fB.write\\fR to a thread after the functions that compute 
 outputs and \\fBsim-io.\\fIN\\fB.read\\fR before those that use the inputs.
 \\fBwrite\\fR latches the output pins into the simulated hardware; \\fBread\\fR
 updates the input pins from it.  An encoder that counts pulses
-(\\fBsim-source\\fR 1 or 2) sees its inputs only when \\fBread\\fR runs: put
+(\\fBsim-source\\fR 1, 2 or 3) sees its inputs only when \\fBread\\fR runs: put
 \\fBread\\fR in the thread of the pulse generator, after it, so that it
 samples every change (e.g. after \\fBstepgen.make-pulses\\fR in the base
 thread, which then needs floating point, as \\fBread\\fR uses it).
@@ -71,11 +71,11 @@ pin out float encoder.MM.velocity "Change of position per second over the last p
 pin in bit encoder.MM.reset "While true count is held at zero";
 pin io bit encoder.MM.index_enable "Set true to zero the count at the next index pulse; cleared by the driver when that happens";
 pin in float encoder.MM.sim_position "Simulated motor position (e.g. a stepgen position-fb), used when sim-source is 0; the counter reads sim-position * position-scale rounded to the nearest whole count";
-pin in bit encoder.MM.phase_A "Encoder input A.  sim-source 1: step, each rising edge is one count (e.g. a stepgen step output); sim-source 2: quadrature channel A";
-pin in bit encoder.MM.phase_B "Encoder input B.  sim-source 1: direction, sampled at the step edge, high counts down (as a stepgen dir output); sim-source 2: quadrature channel B, which A leads when counting up";
+pin in bit encoder.MM.phase_A "Encoder input A.  sim-source 1: step, each rising edge is one count (e.g. a stepgen step output); sim-source 2: quadrature channel A; sim-source 3: up, each rising edge counts up (a stepgen up output)";
+pin in bit encoder.MM.phase_B "Encoder input B.  sim-source 1: direction, sampled at the step edge, high counts down (as a stepgen dir output); sim-source 2: quadrature channel B, which A leads when counting up; sim-source 3: down, each rising edge counts down (a stepgen down output)";
 param rw float encoder.MM.position_scale = 1.0 "Counts per unit of position";
 param rw s32 encoder.MM.sim_counts_per_rev = 1000 "An index pulse occurs at every multiple of this many counts (0: no index)";
-param rw s32 encoder.MM.sim_source = 0 "What the counter counts: 0 follows sim-position, 1 counts step and direction on phase-A and phase-B, 2 decodes quadrature on phase-A and phase-B (a change of both in one read is not counted); changing it keeps the count where it is; other values stop the counter and log an error once";
+param rw s32 encoder.MM.sim_source = 0 "What the counter counts: 0 follows sim-position, 1 counts step and direction on phase-A and phase-B, 2 decodes quadrature on phase-A and phase-B (a change of both in one read is not counted), 3 counts up pulses on phase-A and down pulses on phase-B; changing it keeps the count where it is; other values stop the counter and log an error once";
 
 pin in float switch.MM.position "Simulated axis position";
 pin out bit switch.MM.home "True at or above home-pos";
@@ -128,6 +128,7 @@ typedef struct {
 #define SRC_POSITION 0
 #define SRC_STEP_DIR 1
 #define SRC_QUADRATURE 2
+#define SRC_UP_DOWN 3
 
 typedef struct {
     hal_s32_t *count;
@@ -254,10 +255,10 @@ static void encoder_read(encoder_t *e, long period)
     long long raw = e->raw;
 
     if (scale == 0.0) scale = 1.0;      /* avoid dividing by zero */
-    if (src < SRC_POSITION || src > SRC_QUADRATURE) {
+    if (src < SRC_POSITION || src > SRC_UP_DOWN) {
         if (!e->warned)
             rtapi_print_msg(RTAPI_MSG_ERR,
-                "sim_io: %s.sim-source=%d is not 0, 1 or 2; "
+                "sim_io: %s.sim-source=%d is not 0, 1, 2 or 3; "
                 "the counter stands still\n", e->name, src);
         e->warned = 1;
         src = SRC_NONE;
@@ -285,6 +286,11 @@ static void encoder_read(encoder_t *e, long period)
         if (d == 1)
             raw++;
         else if (d == 3)
+            raw--;
+    } else if (src == SRC_UP_DOWN) {
+        if (a && !e->old_a)
+            raw++;
+        if (b && !e->old_b)
             raw--;
     }
     e->old_a = a;

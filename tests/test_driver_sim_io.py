@@ -278,6 +278,20 @@ def test_quadrature_inputs_count_every_edge(hal):
     assert list(tr[e + "count"]) == [0, 1, 2, 3, 4, 4, 3, 2, 1, 1, 2]
 
 
+def test_up_down_inputs_count_rising_edges(hal):
+    board(hal)
+    e = P + "encoder.00."
+    hal.setp(e + "sim-source", 3)
+    hal.setp(e + "sim-counts-per-rev", 0)
+    # phase-A pulses count up, phase-B pulses down; the first read only
+    # takes the levels
+    up = [1, 0, 1, 0, 1, 1, 0, 0, 0, 0, 1]
+    down = [0, 0, 0, 0, 0, 0, 1, 0, 1, 1, 1]
+    tr = hal.run(len(up), inputs={e + "phase-A": up, e + "phase-B": down},
+                 record=[e + "count"])
+    assert list(tr[e + "count"]) == [0, 0, 1, 1, 2, 2, 1, 1, 0, 0, 1]
+
+
 def test_source_change_keeps_count_and_bad_source_stands_still(hal):
     board(hal)
     e = P + "encoder.00."
@@ -300,7 +314,7 @@ def test_source_change_keeps_count_and_bad_source_stands_still(hal):
     hal.step(1)
     assert hal.getp(e + "count") == 9
     # an unknown source: nothing counts until it is valid again
-    hal.setp(e + "sim-source", 3)
+    hal.setp(e + "sim-source", 4)
     hal.run(4, inputs={e + "sim-position": [50.0, 60.0, 70.0, 80.0],
                        e + "phase-A": [0, 1, 0, 1]})
     assert hal.getp(e + "count") == 9
@@ -316,7 +330,8 @@ def stepgen_loopback(hal, step_type: int) -> str:
     inputs of encoder 00, both in a 25 us base thread (make-pulses, then
     read; read uses floating point, so the thread has it); the slow parts
     of stepgen in a 1 ms servo thread."""
-    outs = ("step", "dir") if step_type == 0 else ("phase-A", "phase-B")
+    outs = {0: ("step", "dir"), 1: ("up", "down")}.get(
+        step_type, ("phase-A", "phase-B"))
     e = P + "encoder.00."
     hal.loadrt("stepgen", f"step_type={step_type}")
     hal.loadrt("sim_io", num_encoder=1)
@@ -330,12 +345,12 @@ def stepgen_loopback(hal, step_type: int) -> str:
     hal.net("sb", "stepgen.0." + outs[1], e + "phase-B")
     hal.set({"stepgen.0.position-scale": 1000.0, "stepgen.0.maxvel": 10.0,
              "stepgen.0.maxaccel": 200.0, "stepgen.0.enable": True,
-             e + "sim-source": 1 if step_type == 0 else 2,
+             e + "sim-source": {0: 1, 1: 3}.get(step_type, 2),
              e + "position-scale": 1000.0, e + "sim-counts-per-rev": 100})
     return e
 
 
-@pytest.mark.parametrize("step_type", [0, 2])
+@pytest.mark.parametrize("step_type", [0, 1, 2])
 def test_stepgen_pulses_counted(hal, step_type):
     e = stepgen_loopback(hal, step_type)
     # forward, back past the start, forward again: 3 direction changes
