@@ -6,7 +6,7 @@ extension module ``halsdk.components.<name>``:
 
 - ``NAME.comp`` goes through halcompile, as ``halcompile --compile`` would
   do it: a C code section becomes generated C (built with the module entry
-  ``halsdk/src/c_module.c``), a Cython one (``option cython``) a generated
+  ``halsdk/core/src/c_module.c``), a Cython one (``option cython``) a generated
   ``.pyx``.  The generated files go to ``build/halcompile/``.
 - ``NAME.pyx`` is a component written in Cython against ``halsdk/hal.pxd``.
 - ``motion/MODULES`` lists the modules of the motion controller (motmod,
@@ -17,7 +17,6 @@ extension module ``halsdk.components.<name>``:
 
 import glob
 import os
-import shlex
 import sys
 
 from Cython.Build import cythonize
@@ -26,70 +25,52 @@ from setuptools import Extension, setup
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)        # halcompile, from this source tree
 
-from halcompile import gen_c, gen_cython  # noqa: E402
-from halcompile.parser import CompError, parse_file  # noqa: E402
+from halcompile.parser import CompError  # noqa: E402
+from halcompile.sources import generate_source  # noqa: E402
 
 GENERATED = os.path.join("build", "halcompile")
 FLAGS = ["-O2", "-std=gnu11", "-Wall", "-Wno-unused-function"]
 
 core = Extension(
-    "halsdk._core",
+    "halsdk.core._core",
     sources=[
-        "halsdk/_core.pyx",
-        "halsdk/src/hal_core.c",
-        "halsdk/src/hal_thread.c",
-        "halsdk/src/hal_api.c",
-        "halsdk/src/hal_stream.c",
-        "halsdk/src/hal_shmem.c",
-        "halsdk/src/hal_symbol.c",
+        "halsdk/core/_core.pyx",
+        "halsdk/core/src/hal_core.c",
+        "halsdk/core/src/hal_thread.c",
+        "halsdk/core/src/hal_api.c",
+        "halsdk/core/src/hal_stream.c",
+        "halsdk/core/src/hal_shmem.c",
+        "halsdk/core/src/hal_symbol.c",
     ],
-    include_dirs=["halsdk/include", "halsdk/src"],
+    include_dirs=["halsdk/include", "halsdk/core/src"],
     extra_compile_args=FLAGS,
     libraries=["rt", "pthread"],
 )
 
 
-def _write(path, text):
-    """Write a generated file only when it changes (keeps builds
-    incremental)."""
-    try:
-        with open(path, encoding="utf-8") as f:
-            if f.read() == text:
-                return
-    except OSError:
-        pass
-    with open(path, "w", encoding="utf-8") as f:
-        f.write(text)
-
-
 def comp_extension(path, package="halsdk.components"):
-    """The extension module of one shipped ``.comp`` file."""
+    """The extension module of one shipped ``.comp`` file, from the source
+    that halcompile generates for it (the API the halcompile command
+    builds with too)."""
     try:
-        comp = parse_file(path)
+        src = generate_source(path, GENERATED)
     except CompError as exc:
         sys.exit(f"error: {exc}")
-    if comp.option("userspace"):
+    if src.userspace:
         sys.exit(f"error: {path}: shipped components are realtime ones")
-    os.makedirs(GENERATED, exist_ok=True)
-    flags = FLAGS + ["-fvisibility=hidden"] + shlex.split(
-        str(comp.option("extra_compile_args", "")))
-    links = shlex.split(str(comp.option("extra_link_args", "")))
-    if comp.option("cython"):
-        text, _ = gen_cython.generate(comp)
-        pyx = os.path.join(GENERATED, comp.name + ".pyx")
-        _write(pyx, text)
-        return Extension(f"{package}.{comp.name}", sources=[pyx],
+    flags = FLAGS + ["-fvisibility=hidden"] + src.compile_args
+    if src.language == "cython":
+        return Extension(f"{package}.{src.comp.name}", sources=[src.path],
                          include_dirs=["halsdk/include", "components"],
-                         extra_compile_args=flags, extra_link_args=links)
-    c_file = os.path.join(GENERATED, comp.name + ".c")
-    _write(c_file, gen_c.generate(comp, os.path.abspath(c_file)))
+                         extra_compile_args=flags,
+                         extra_link_args=src.link_args)
     return Extension(
-        f"{package}.{comp.name}",
-        sources=["halsdk/src/c_module.c", c_file],
+        f"{package}.{src.comp.name}",
+        sources=["halsdk/core/src/c_module.c", src.path],
         include_dirs=["halsdk/include", "components"],
-        define_macros=[("HALSDK_MODULE_NAME", comp.name),
+        define_macros=[("HALSDK_MODULE_NAME", src.comp.name),
                        ("HALSDK_API_EXTERN", "1"), ("RTAPI", None)],
-        extra_compile_args=flags, extra_link_args=links)
+        extra_compile_args=flags, extra_link_args=src.link_args)
 
 
 components = [comp_extension(p)
@@ -146,7 +127,7 @@ def motion_extensions():
             extra = {"extra_objects": [lib], "language": "c++"}
         exts.append(Extension(
             "halsdk.components." + name.strip(),
-            sources=["halsdk/src/c_module.c"] + sources,
+            sources=["halsdk/core/src/c_module.c"] + sources,
             include_dirs=["halsdk/include", folder]
             + ([include] if cxx else []),
             define_macros=[("HALSDK_MODULE_NAME", name.strip()),
@@ -174,15 +155,13 @@ def python_drivers() -> list:
 
 
 setup(
-    packages=["halsdk", "halsdk.compat", "halsdk.demo", "halsdk.halcmd",
+    packages=["halsdk", "halsdk.core", "halsdk.compat", "halsdk.demo", "halsdk.halcmd",
               "halsdk.components", "halsdk.gcode", "halsdk.machine",
               "halsdk.motion", "halsdk.tools", "halcompile",
-              "halsdk.demo.mill", "halsdk.driver", "halsdk.drivers",
+              "halsdk.driverkit", "halsdk.drivers",
               *python_drivers()],
-    # the demo's machine is examples/mill, installed as package data
     package_dir={"halsdk.components": "components",
-                 "halsdk.drivers": "drivers",
-                 "halsdk.demo.mill": "examples/mill"},
+                 "halsdk.drivers": "drivers"},
     ext_modules=cythonize([core] + components, language_level=3, quiet=True,
                           include_path=["."]),
 )

@@ -151,7 +151,7 @@ def planner_alone(points: np.ndarray, feed: float, tol: float,
                   prog_acc: float) -> Optional[dict]:
     """tpmod's run_cycle timed cycle by cycle on the same lines."""
     import halsdk
-    from halsdk import _core
+    from halsdk.core import _core
 
     with halsdk.Hal(instance=f"benchtp-alone-{os.getpid()}") as hal:
         hal.loadrt("tpmod", queue_size=len(points) + 10)

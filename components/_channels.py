@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from typing import Optional
 
-from halsdk import _core
+from halsdk.core import _core
 
 MAX_ELEMENTS = 256
 

@@ -17,7 +17,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Optional, Union
 
-from halsdk import _core
+from halsdk.core import _core
 from halsdk.errors import HalError, InvalidError
 
 # The modparams entries a count/names component declares.

@@ -1,5 +1,5 @@
 # sampler: copy HAL pins into a stream once per thread cycle, for
-# halsampler (or Python: halsdk._core.stream_attach("sampler.N")).
+# halsampler (or Python: halsdk.core._core.stream_attach("sampler.N")).
 #
 #     loadrt sampler depth=D0[,D1...] cfg=CFG0[,CFG1...]
 #
@@ -11,7 +11,7 @@
 
 from halsdk cimport hal
 
-from halsdk.components._channels import MODPARAMS, channels
+from ._channels import MODPARAMS, channels
 
 hal.import_halsdk()
 

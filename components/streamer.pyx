@@ -13,7 +13,7 @@
 
 from halsdk cimport hal
 
-from halsdk.components._channels import MODPARAMS, channels
+from ._channels import MODPARAMS, channels
 
 hal.import_halsdk()
 

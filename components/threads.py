@@ -8,7 +8,7 @@ it can be loaded again to make more.
 
 from __future__ import annotations
 
-from halsdk import _core
+from halsdk.core import _core
 from halsdk.errors import InvalidError
 
 modparams = {}

@@ -12,23 +12,29 @@ Typical use::
         hal.step(1000)            # deterministic, simulated time
 """
 
-from halsdk import _core
+import importlib.util as _util
+
+if _util.find_spec("halsdk.core._core") is None:    # a checkout, not built
+    raise ModuleNotFoundError(
+        f"halsdk is not built here ({__path__[0]}): pip install -e .",
+        name="halsdk.core._core")
 from halsdk.component import Component, component
+from halsdk.core import _core  # noqa: E402
+from halsdk.core.instance import cleanup
 from halsdk.errors import (
-                           CapacityError,
-                           ConflictError,
-                           ExistsError,
-                           HalError,
-                           HalTypeError,
-                           InstanceError,
-                           InvalidError,
-                           LoadError,
-                           NotFoundError,
-                           NotPermittedError,
-                           StaleError,
+    CapacityError,
+    ConflictError,
+    ExistsError,
+    HalError,
+    HalTypeError,
+    InstanceError,
+    InvalidError,
+    LoadError,
+    NotFoundError,
+    NotPermittedError,
+    StaleError,
 )
 from halsdk.hal import Hal
-from halsdk.instance import cleanup
 from halsdk.types import Direction, HalType
 
 Pin = _core.Pin

@@ -39,7 +39,7 @@ from halsdk.errors import HalError
 
 PACKAGE_DIR = os.path.dirname(os.path.abspath(__file__))
 INCLUDE_DIR = os.path.join(PACKAGE_DIR, "include")
-C_ENTRY = os.path.join(PACKAGE_DIR, "src", "c_module.c")
+C_ENTRY = os.path.join(PACKAGE_DIR, "core", "src", "c_module.c")
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 _DIAG = re.compile(r"^\S[^:]*:\d+:(\d+:)? |^In file included|^\s+\d* *\||"
                    r"[Ee]rror")
@@ -93,7 +93,7 @@ def _digest(paths: Sequence[str], extra: Sequence[str],
         with open(p, "rb") as f:
             h.update(f.read())
     # the realtime driver helpers that a module may cimport
-    rt_dir = os.path.join(PACKAGE_DIR, "driver")
+    rt_dir = os.path.join(PACKAGE_DIR, "driverkit")
     for name in sorted(os.listdir(rt_dir)):
         if name.endswith(".pxd"):
             with open(os.path.join(rt_dir, name), "rb") as f:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any, Optional, Union
 
-from halsdk import _core, instance
+from halsdk.core import _core, instance
 from halsdk.errors import ExistsError, NotFoundError, NotPermittedError
 from halsdk.types import parse_direction, parse_type
 

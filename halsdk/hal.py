@@ -9,7 +9,7 @@ import time
 from collections.abc import Iterable
 from typing import Any, Callable, Optional, Union
 
-from halsdk import _core, channel, instance
+from halsdk.core import _core, channel, instance
 from halsdk.errors import (
     ConflictError,
     HalTypeError,
@@ -49,7 +49,7 @@ class Hal:
 
     def __init__(self, instance: Optional[str] = None, *,
                  create: Optional[bool] = None, size: Optional[int] = None):
-        from halsdk import instance as inst_mod
+        from halsdk.core import instance as inst_mod
         self._conn = inst_mod.connect(instance, create=create, size=size)
         self._closed = False
         conn = self._conn

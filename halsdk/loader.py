@@ -39,7 +39,7 @@ from dataclasses import dataclass, field
 from types import ModuleType
 from typing import Any, Optional
 
-from halsdk import _core
+from halsdk.core import _core
 from halsdk.errors import (
     ConflictError,
     ExistsError,

@@ -27,7 +27,7 @@ import numpy as np
 import pytest
 
 import halsdk
-from halsdk import _core
+from halsdk.core import _core
 
 _counter = itertools.count()
 _created: list[str] = []
@@ -126,7 +126,7 @@ def hal(monkeypatch: pytest.MonkeyPatch, request: pytest.FixtureRequest):
     marker = request.node.get_closest_marker("hal_size")
     size = marker.args[0] if marker else TEST_INSTANCE_SIZE
     h = TestHal(name, create=True, size=size)
-    _created.append(halsdk.instance.shm_name(name))
+    _created.append(halsdk.core.instance.shm_name(name))
     try:
         yield h
     finally:
@@ -134,11 +134,11 @@ def hal(monkeypatch: pytest.MonkeyPatch, request: pytest.FixtureRequest):
             h.stop()
         except halsdk.HalError:
             pass
-        conn = halsdk.instance.current()
+        conn = halsdk.core.instance.current()
         h.close()
         # components the test left open must not keep the instance alive
-        if conn is not None and halsdk.instance.current() is conn:
-            halsdk.instance._teardown(conn)
+        if conn is not None and halsdk.core.instance.current() is conn:
+            halsdk.core.instance._teardown(conn)
 
 
 def leftover_instances(shm_names: Iterable[str]) -> list[str]:

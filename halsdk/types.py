@@ -5,7 +5,7 @@ from __future__ import annotations
 from enum import IntEnum
 from typing import Union
 
-from halsdk import _core
+from halsdk.core import _core
 from halsdk.errors import InvalidError
 
 

@@ -7,7 +7,7 @@ import os
 import pytest
 
 import halsdk
-from halsdk import _core
+from halsdk.core import _core
 
 
 def test_second_hal_in_a_process_shares_the_instance(hal):
@@ -134,7 +134,7 @@ def test_instance_info_counts(hal):
 
 def test_half_made_segment_is_waited_for_and_cleaned_only_when_old():
     name = halsdk.testing.private_instance_name()
-    shm = halsdk.instance.shm_name(name)
+    shm = halsdk.core.instance.shm_name(name)
     path = "/dev/shm" + shm
     fd = os.open(path, os.O_CREAT | os.O_WRONLY, 0o600)   # empty: "creating"
     os.close(fd)

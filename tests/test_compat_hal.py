@@ -26,8 +26,8 @@ import pytest
 
 import halsdk
 import halsdk.compat
-from halsdk import _core
 from halsdk.compat import hal as compat
+from halsdk.core import _core
 
 REPO = Path(__file__).resolve().parent.parent
 DATA = Path(__file__).resolve().parent / "data" / "compat"
@@ -845,7 +845,7 @@ def test_component_creates_an_instance_when_none_runs(tmp_path):
     """With no instance running, hal.component() makes one (this process is
     its host) and removes it at exit."""
     name = f"compat-{os.getpid()}-solo"
-    shm = halsdk.instance.shm_name(name)
+    shm = halsdk.core.instance.shm_name(name)
     script = (
         "import hal, signal\n"
         "h = hal.component('solo')\n"
@@ -869,7 +869,7 @@ def test_own_instance_is_left_clean(children, monkeypatch):
     once it is unloaded and the instance closed."""
     name = f"compat-{os.getpid()}-own"
     monkeypatch.setenv("HALSDK_INSTANCE", name)
-    shm = "/dev/shm" + halsdk.instance.shm_name(name)
+    shm = "/dev/shm" + halsdk.core.instance.shm_name(name)
     with halsdk.Hal(name, create=True) as host:
         assert os.path.exists(shm)
         child = children("scale.py")

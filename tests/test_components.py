@@ -10,8 +10,8 @@ import time
 import pytest
 
 import halsdk
-from halsdk import _core
 from halsdk.build import BuildError, build_component
+from halsdk.core import _core
 from halsdk.loader import import_component
 
 
@@ -292,7 +292,7 @@ def test_component_from_entry_point_group(hal, tmp_path, monkeypatch):
         "modparams = {'gain': (float, 1.0, 'gain')}\n"
         "made = []\n"
         "def setup(gain=1.0):\n"
-        "    from halsdk import _core\n"
+        "    from halsdk.core import _core\n"
         "    cid = _core.comp_new('tpy', _core.COMP_RT)\n"
         "    made.append(gain)\n"
         "    _core.comp_ready(cid)\n")

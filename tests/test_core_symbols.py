@@ -11,7 +11,7 @@ from conftest import on_halsdk_path
 from test_halcompile import COMPS, halcompile
 
 import halsdk
-from halsdk import _core
+from halsdk.core import _core
 
 MODS = ["hcsymexp", "hcsymuse"]
 

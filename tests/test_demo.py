@@ -1,4 +1,4 @@
-"""The README demo (``halsdk-demo``): the simulated mill of examples/mill is
+"""The README demo (``halsdk-demo``): the simulated mill of halsdk/demo/mill is
 turned on, homed and runs demo.ngc (two tool changes, an arc, a probe),
 stepped and deterministic; the summary's numbers and the plot are checked."""
 
@@ -14,7 +14,7 @@ import halsdk.demo
 from halsdk.ini import IniFile
 from halsdk.testing import private_instance_name
 
-MILL = Path(__file__).resolve().parents[1] / "examples" / "mill"
+MILL = Path(__file__).resolve().parents[1] / "halsdk" / "demo" / "mill"
 
 
 @pytest.fixture(scope="module")

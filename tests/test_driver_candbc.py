@@ -16,7 +16,7 @@ import cantools
 import pytest
 from conftest import ended_at_exit, sigterm
 
-from halsdk.driver import FAULT_OPEN, FAULT_READ, IOLoop
+from halsdk.driverkit import FAULT_OPEN, FAULT_READ, IOLoop
 from halsdk.drivers.candbc import (
     CanDbcDriver,
     ConfigError,
@@ -197,7 +197,7 @@ def test_multiplexed_message_updates_only_its_page(hal, rig):
 
 def test_malformed_and_unknown_frames(hal, rig, caplog):
     r = rig("--node", "PLC")
-    with caplog.at_level(logging.ERROR, "halsdk.driver"):
+    with caplog.at_level(logging.ERROR, "halsdk.driverkit"):
         for _ in range(3):
             r.bus.send(can.Message(arbitration_id=0x100, data=b"\x01\x02",
                                    is_extended_id=False))
@@ -339,7 +339,7 @@ def test_bus_failure_faults_and_reconnects(hal, rig, caplog, monkeypatch):
     def broken(timeout=None):
         raise can.CanOperationError("network is down")
     r.driver.bus.recv = broken
-    caplog.set_level(logging.ERROR, "halsdk.driver")
+    caplog.set_level(logging.ERROR, "halsdk.driverkit")
     r.step()
     assert hal.getp(P + "fault") and not hal.getp(P + "connected")
     assert hal.getp(P + "fault-code") == FAULT_READ

@@ -16,7 +16,7 @@ from pathlib import Path
 import can
 import pytest
 
-from halsdk.driver import IOLoop
+from halsdk.driverkit import IOLoop
 from halsdk.drivers.cia402 import statemachine as sm
 from halsdk.drivers.cia402.__main__ import main
 from halsdk.drivers.cia402.codes import emcy_text

@@ -277,7 +277,7 @@ def test_a_flood_is_dropped_counted_and_logged_once(hal, broker, bridges,
         for i in range(n):
             bridge.link._on_message(None, None, SimpleNamespace(
                 topic=topic, payload=str(i).encode()))
-    with caplog.at_level(logging.WARNING, "halsdk.driver.mqtt"):
+    with caplog.at_level(logging.WARNING, "halsdk.driverkit.mqtt"):
         flood(MAX_PENDING + 5)
         assert len(bridge.link.events) == MAX_PENDING     # bounded
         bridge.cycle()
@@ -301,7 +301,7 @@ def test_bad_payloads_counted_logged_once(hal, broker, bridges, listeners,
     lst.send(f"{PREFIX}/count/set", 7)
     assert wait_until(lambda: bridge.comp["received"] == 2,
                       step=bridge.cycle)
-    with caplog.at_level(logging.WARNING, "halsdk.driver.mqtt"):
+    with caplog.at_level(logging.WARNING, "halsdk.driverkit.mqtt"):
         for topic, raw in BAD:
             lst.send(f"{PREFIX}/{topic}", raw)
         assert wait_until(lambda: bridge.comp["received"] == 2 + len(BAD),
@@ -333,7 +333,7 @@ def test_payload_depth_and_size_limits():
 def test_broker_restart(hal, source, broker, bridges, listeners, caplog):
     bridge = bridges(broker.port, publish=[("", "src.x")])
     assert connected(bridge)
-    with caplog.at_level(logging.WARNING, "halsdk.driver.mqtt"):
+    with caplog.at_level(logging.WARNING, "halsdk.driverkit.mqtt"):
         broker.stop()
         assert wait_until(lambda: not bridge.comp["connected"],
                           step=bridge.cycle)
@@ -377,7 +377,7 @@ def test_wrong_credentials(hal, source, broker, bridges, caplog):
     broker.stop()
     secure.add_user("cnc", "s3cret")
     secure.start()
-    with caplog.at_level(logging.ERROR, "halsdk.driver.mqtt"):
+    with caplog.at_level(logging.ERROR, "halsdk.driverkit.mqtt"):
         bad = bridges(secure.port, publish=[("", "src.x")], user="cnc",
                       password="wrong", name="bad-login")
         assert wait_until(lambda: bad.comp["fault"], step=bad.cycle)

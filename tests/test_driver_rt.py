@@ -1,4 +1,4 @@
-"""Realtime driver helpers (halsdk/driver/rt.pxd) and the worked example
+"""Realtime driver helpers (halsdk/driverkit/rt.pxd) and the worked example
 examples/rt-driver/rtboard.pyx, built and loaded as realtime modules."""
 
 from __future__ import annotations
@@ -11,22 +11,23 @@ import textwrap
 import pytest
 
 import halsdk
-from halsdk import _core, build
+from halsdk import build
 from halsdk.build import build_component
+from halsdk.core import _core
 from halsdk.errors import HalError, InvalidError
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 EXAMPLE = os.path.join(ROOT, "examples", "rt-driver")
 # rt.pxd as the build finds it: Cython's include path is the folder that
 # holds the installed halsdk package
-DRIVER_PXD_DIR = os.path.join(build.PACKAGE_DIR, "driver")
+DRIVER_PXD_DIR = os.path.join(build.PACKAGE_DIR, "driverkit")
 B = "rtboard.0."
 
 # a second driver that uses the helpers the example does not: 32-bit
 # counters, functions per io-type, and the fault helpers from Python
 MINI = textwrap.dedent("""
     from halsdk cimport hal
-    from halsdk.driver cimport rt
+    from halsdk.driverkit cimport rt
 
     hal.import_halsdk()
 
@@ -118,7 +119,7 @@ def kinds(items):
 
 def test_rt_pxd_is_on_the_build_include_path():
     # the build passes the parent of the halsdk package to Cython, so the
-    # installed halsdk/driver/rt.pxd is what `cimport rt` finds
+    # installed halsdk/driverkit/rt.pxd is what `cimport rt` finds
     assert os.path.isfile(os.path.join(DRIVER_PXD_DIR, "rt.pxd"))
     assert os.path.isfile(os.path.join(DRIVER_PXD_DIR, "__init__.py"))
     assert os.path.dirname(halsdk.__file__) == build.PACKAGE_DIR

@@ -1,4 +1,4 @@
-"""The userspace driver SDK (halsdk.driver) on a fake I/O board."""
+"""The userspace driver SDK (halsdk.driverkit) on a fake I/O board."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ import time
 
 import pytest
 
-from halsdk.driver import (
+from halsdk.driverkit import (
     FAULT_NONE,
     FAULT_OPEN,
     FAULT_READ,
@@ -214,7 +214,7 @@ def test_disappear_backoff_grows_then_resets(hal, rig, caplog):
         attempts.append(clock.now)
         real_open()
     drv.open = counting_open
-    with caplog.at_level(logging.INFO, "halsdk.driver"):
+    with caplog.at_level(logging.INFO, "halsdk.driverkit"):
         for _ in range(400):                      # 4 s of cycles
             step(loop, clock)
     assert hal.getp("fakedev.0.fault")
@@ -240,7 +240,7 @@ def test_disappear_backoff_grows_then_resets(hal, rig, caplog):
 def test_read_always_raising(hal, rig, caplog):
     board, drv, loop, clock = rig
     board.broken_reads = True
-    with caplog.at_level(logging.ERROR, "halsdk.driver"):
+    with caplog.at_level(logging.ERROR, "halsdk.driverkit"):
         step(loop, clock, n=300)
     assert hal.getp("fakedev.0.fault")
     assert hal.getp("fakedev.0.fault-code") == FAULT_READ
@@ -291,7 +291,7 @@ def test_sigterm_stops_loadusr_process(tmp_path, hal):
     script = tmp_path / "drv.py"
     script.write_text(textwrap.dedent("""
         import sys
-        from halsdk.driver import Driver, IOLoop
+        from halsdk.driverkit import Driver, IOLoop
 
         class Tiny(Driver):
             name = "tiny"
@@ -375,7 +375,7 @@ def test_threaded_loop_ends_when_component_removed(hal, caplog):
     board = FakeBoard()
     drv = FakeDriver(board, num=2)
     loop = IOLoop(drv, period=0.005)
-    with caplog.at_level(logging.WARNING, "halsdk.driver"):
+    with caplog.at_level(logging.WARNING, "halsdk.driverkit"):
         thread = loop.start_thread()
         hal.unload("fakedev.2")       # as unloadusr does
         thread.join(5)

@@ -10,7 +10,7 @@ from conftest import on_halsdk_path
 
 import halsdk
 from halcompile.cli import process
-from halsdk import _core
+from halsdk.core import _core
 
 P = "sim-io.0."
 SOURCE = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(

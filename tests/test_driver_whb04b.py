@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 from conftest import ended_at_exit, sigterm
 
-from halsdk.driver import FAULT_NONE, FAULT_OPEN, FAULT_READ, IOLoop
+from halsdk.driverkit import FAULT_NONE, FAULT_OPEN, FAULT_READ, IOLoop
 from halsdk.drivers.whb04b import BUTTON_NAMES, FakeBackend, Whb04bDriver
 from halsdk.drivers.whb04b.fake import ScriptError, load_script, parse_script
 from halsdk.types import Direction, HalType
@@ -186,7 +186,7 @@ def test_display_encoding_byte_exact(hal, rig):
 
 def test_malformed_reports_counted_logged_once(rig, caplog):
     rig.usb.add(*load_script(DATA / "malformed.txt"))
-    with caplog.at_level(logging.WARNING, "halsdk.driver"):
+    with caplog.at_level(logging.WARNING, "halsdk.driverkit"):
         rig.step(n=3)
     assert rig.get("bad-reports") == 5
     assert rig.get("reports") == 7
@@ -205,7 +205,7 @@ def test_bad_header_alone(rig):
 
 
 def test_absent_at_start_then_plugged(hal, caplog):
-    with caplog.at_level(logging.ERROR, "halsdk.driver"):
+    with caplog.at_level(logging.ERROR, "halsdk.driverkit"):
         r = Rig(hal, load_script(DATA / "absent-then-plugged.txt"))
         try:
             r.step()
@@ -225,7 +225,7 @@ def test_absent_at_start_then_plugged(hal, caplog):
 
 
 def test_unplug_and_replug(hal, caplog):
-    with caplog.at_level(logging.ERROR, "halsdk.driver"):
+    with caplog.at_level(logging.ERROR, "halsdk.driverkit"):
         r = Rig(hal, load_script(DATA / "unplug-replug.txt"))
         try:
             r.step()                       # reads both reports, then ENODEV

@@ -17,10 +17,10 @@ from pathlib import Path
 import pytest
 from conftest import ended_at_exit, sigterm
 
-from halsdk import _core
+from halsdk.core import _core
 from halsdk.ini import IniFile
-from halsdk.launcher import Launcher
 from halsdk.machine import InterpState, Machine, TaskMode, TaskState
+from halsdk.machine.launcher import Launcher
 from halsdk.testing import private_instance_name
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "cia402"
@@ -156,7 +156,7 @@ def test_square_on_two_cia402_drives_then_a_clean_shutdown(machine):
 def test_halsdk_run_and_sigterm_end_the_driver(tmp_path, python_tools_first):
     ini = copy_example(tmp_path)
     env = dict(os.environ, HALSDK_INSTANCE=private_instance_name())
-    proc = subprocess.Popen([sys.executable, "-m", "halsdk.cli", "run",
+    proc = subprocess.Popen([sys.executable, "-m", "halsdk.machine.cli", "run",
                              str(ini)], cwd=str(tmp_path), env=env,
                             text=True, stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE)

@@ -1,4 +1,4 @@
-"""examples/mill: the simulated three-axis servo mill (pid loops, simulated
+"""halsdk/demo/mill: the simulated three-axis servo mill (pid loops, simulated
 motors and encoders, home switches with index) is started from its INI file,
 enabled, homed, jogged and moved along a line and an arc, deterministically;
 the tuned loops keep the following error far below the limits."""
@@ -13,10 +13,10 @@ from pathlib import Path
 import pytest
 
 from halsdk.ini import IniFile
-from halsdk.launcher import Launcher
+from halsdk.machine.launcher import Launcher
 from halsdk.testing import private_instance_name
 
-MILL = Path(__file__).resolve().parents[1] / "examples" / "mill"
+MILL = Path(__file__).resolve().parents[1] / "halsdk" / "demo" / "mill"
 INI = MILL / "mill.ini"
 JOINTS = range(3)
 
@@ -175,7 +175,7 @@ def test_the_toolchanger_stand_in_acknowledges_prepare_and_change(
 
 def test_halsdk_run_starts_and_stops_the_mill(tmp_path):
     env = dict(os.environ, HALSDK_INSTANCE=private_instance_name())
-    proc = subprocess.run([sys.executable, "-m", "halsdk.cli", "run",
+    proc = subprocess.run([sys.executable, "-m", "halsdk.machine.cli", "run",
                            str(INI), "--seconds", "1"], cwd=str(tmp_path),
                           env=env, text=True, capture_output=True, timeout=60)
     assert proc.returncode == 0, proc.stderr

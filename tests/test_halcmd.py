@@ -33,7 +33,8 @@ from pathlib import Path
 
 import pytest
 
-from halsdk import _core, halcmd
+from halsdk import halcmd
+from halsdk.core import _core
 from halsdk.halcmd import Executor, logical_lines, parse_value, tokenize
 from halsdk.halcmd.lexer import IniFile, SubstitutionError
 

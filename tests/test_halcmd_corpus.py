@@ -23,7 +23,7 @@ from pathlib import Path
 
 import pytest
 
-from halsdk import _core
+from halsdk.core import _core
 from halsdk.halcmd import Executor
 
 STREAMS = Path(__file__).parent / "data" / "streams"

@@ -135,8 +135,8 @@ def test_mux2_selects(hal, comp_dir):
     hal.loadrt("hcmux2", count=2)
     assert own_pins(hal, "hcmux2.1.*") == [
         "hcmux2.1.in0", "hcmux2.1.in1", "hcmux2.1.out", "hcmux2.1.sel"]
-    assert hal.pin("hcmux2.0.sel").direction == halsdk._core.IN
-    assert hal.pin("hcmux2.0.out").direction == halsdk._core.OUT
+    assert hal.pin("hcmux2.0.sel").direction == halsdk.core._core.IN
+    assert hal.pin("hcmux2.0.out").direction == halsdk.core._core.OUT
     hal.newthread("servo", PERIOD)
     hal.addf("hcmux2.0", "servo")
     hal.set({"hcmux2.0.in0": 1.5, "hcmux2.0.in1": -2.0})
@@ -162,7 +162,7 @@ def test_arrays_types_and_defaults(hal, comp_dir):
         "hcarrays.0.half"]
     assert names(hal.functions("hcarrays.*")) == [
         "hcarrays.0", "hcarrays.0.count-calls"]
-    c = halsdk._core
+    c = halsdk.core._core
     types = {n: hal.pin("hcarrays.0." + n).type for n in
              ("big", "ubig", "flag", "count", "sum", "idx.01.v")}
     assert types == {"big": c.S64, "ubig": c.U64, "flag": c.BIT,

@@ -11,7 +11,7 @@ import time
 import pytest
 
 import halsdk
-from halsdk import _core
+from halsdk.core import _core
 from halsdk.tools import halmeter
 
 

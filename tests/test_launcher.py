@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from halsdk.launcher import Launcher, LaunchError
+from halsdk.machine.launcher import Launcher, LaunchError
 from halsdk.testing import private_instance_name
 
 MILL = Path(__file__).resolve().parents[1] / "examples" / "motion" / "mill3.ini"
@@ -20,7 +20,7 @@ MILL = Path(__file__).resolve().parents[1] / "examples" / "motion" / "mill3.ini"
 
 def halsdk_run(tmp_path: Path, *args: str, **kw) -> subprocess.Popen:
     env = dict(os.environ, HALSDK_INSTANCE=private_instance_name())
-    return subprocess.Popen([sys.executable, "-m", "halsdk.cli", "run", *args],
+    return subprocess.Popen([sys.executable, "-m", "halsdk.machine.cli", "run", *args],
                             cwd=str(tmp_path), env=env, text=True,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                             **kw)
@@ -67,7 +67,7 @@ def test_a_failing_hal_file_names_its_line_and_leaves_nothing(tmp_path):
     ini = write(tmp_path, "m.ini", "[HAL]\nHALFILE = m.hal\n")
     name = private_instance_name()
     env = dict(os.environ, HALSDK_INSTANCE=name)
-    proc = subprocess.run([sys.executable, "-m", "halsdk.cli", "run",
+    proc = subprocess.run([sys.executable, "-m", "halsdk.machine.cli", "run",
                            str(ini)], cwd=str(tmp_path), env=env, text=True,
                           capture_output=True, timeout=60)
     assert proc.returncode == 1

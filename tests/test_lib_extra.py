@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import halsdk
-from halsdk import _core
+from halsdk.core import _core
 
 PERIOD = 1_000_000
 

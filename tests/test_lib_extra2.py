@@ -11,7 +11,7 @@ import pytest
 from test_lib_extra import setup
 
 import halsdk
-from halsdk import _core
+from halsdk.core import _core
 
 # feedcomp ----------------------------------------------------------------
 

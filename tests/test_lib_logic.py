@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import halsdk
-from halsdk import _core
+from halsdk.core import _core
 
 MS = 1_000_000
 RNG = np.random.default_rng(1234)

@@ -97,7 +97,7 @@ def test_flipflop_clock_set_and_reset(hal):
 
 def test_flipflop_out_is_io_and_keeps_a_set_value(hal):
     start(hal, "flipflop", fp=False)
-    assert hal.pin("flipflop.0.out").direction == halsdk._core.IO
+    assert hal.pin("flipflop.0.out").direction == halsdk.core._core.IO
     hal.setp("flipflop.0.out", True)
     hal.step(3)
     assert hal.getp("flipflop.0.out") is True

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import halsdk
-from halsdk import _core
+from halsdk.core import _core
 
 MS = 1_000_000
 

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import halsdk
-from halsdk import _core
+from halsdk.core import _core
 
 BASE = 25_000           # ns, make-pulses
 SERVO = 1_000_000       # ns, update-freq / capture-position / update

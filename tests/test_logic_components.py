@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 import halsdk
-from halsdk import _core
 from halsdk.components._instances import instance_names, split_names
+from halsdk.core import _core
 
 GATES = {
     "and2": lambda a, b: a and b,

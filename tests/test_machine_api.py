@@ -345,7 +345,7 @@ def test_step_and_start_line(machine, tmp_path):
 
 
 def test_from_launcher_reads_the_emcio_section(tmp_path, monkeypatch):
-    from halsdk.launcher import Launcher
+    from halsdk.machine.launcher import Launcher
     from halsdk.testing import private_instance_name
     monkeypatch.setenv("HALSDK_INSTANCE", private_instance_name())
     mill = Path(__file__).resolve().parents[1] / "examples" / "motion"

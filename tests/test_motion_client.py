@@ -18,7 +18,7 @@ import threading
 import numpy as np
 import pytest
 
-from halsdk import _core
+from halsdk.core import _core
 from halsdk.errors import HalError
 from halsdk.motion import (
     Mode,

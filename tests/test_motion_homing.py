@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 
 import halsdk
-from halsdk import _core
+from halsdk.core import _core
 
 DT = 0.001
 PERIOD_NS = 1_000_000

@@ -3,7 +3,7 @@
 The load listings are compared with the reference's (tests/motion/kins-*).
 The transforms are C functions that each module exports
 (kinematicsForward, kinematicsInverse, ...); the tests call them through
-ctypes at the addresses halsdk._core.symbol_address() gives: round trips
+ctypes at the addresses halsdk.core._core.symbol_address() gives: round trips
 over each workspace, known points (some with the reference's numbers),
 and points without a solution, which must give a non-zero return and
 leave the output untouched (so no NaN ever comes out).
@@ -21,7 +21,7 @@ from conftest import on_halsdk_path
 from test_halcmd import _cli, _env, _shm_left, normalize
 
 import halsdk
-from halsdk import _core
+from halsdk.core import _core
 
 MOTION = Path(__file__).parent / "motion"
 AXES = "x y z a b c u v w".split()

@@ -20,7 +20,7 @@ import pytest
 from test_halcmd import _cli, _env, _shm_left, normalize
 
 import halsdk
-from halsdk import _core
+from halsdk.core import _core
 
 MOTION = Path(__file__).parent / "motion"
 DT = 0.001                      # servo period of the tests (s)

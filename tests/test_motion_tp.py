@@ -17,7 +17,7 @@ import math
 import numpy as np
 import pytest
 
-from halsdk import _core
+from halsdk.core import _core
 
 DT = 1e-3
 

@@ -33,7 +33,7 @@ from typing import Any, Callable, Optional
 import pytest
 
 import halsdk
-from halsdk import _core, channel
+from halsdk.core import _core, channel
 from halsdk.errors import ConflictError, InstanceError
 
 DATA = Path(__file__).parent / "data" / "multiprocess"
@@ -154,13 +154,13 @@ def spawn() -> Iterator[Callable[..., Child]]:
 def no_connection() -> Iterator[None]:
     """For tests that connect by themselves: this process must not use an
     instance yet (one instance per process), and must not keep one."""
-    if halsdk.instance.current() is not None:
+    if halsdk.core.instance.current() is not None:
         pytest.fail("this process already uses a HAL instance; an earlier "
                     "test left it open")
     yield
-    conn = halsdk.instance.current()
+    conn = halsdk.core.instance.current()
     if conn is not None:
-        halsdk.instance._teardown(conn)
+        halsdk.core.instance._teardown(conn)
         pytest.fail("the test left this process connected to a HAL instance")
 
 
@@ -208,13 +208,13 @@ def wait_for(predicate: Callable[[], Any], what: str,
 
 def segment_file(instance: Optional[str] = None) -> str:
     """The /dev/shm path of an instance (default: $HALSDK_INSTANCE)."""
-    return SHM_DIR + halsdk.instance.shm_name(instance)
+    return SHM_DIR + halsdk.core.instance.shm_name(instance)
 
 
 def remove_instance_files(instance: str) -> None:
     """Last-resort cleanup of an instance left by a test's children."""
     for path in (segment_file(instance),
-                 channel.socket_path(halsdk.instance.shm_name(instance))):
+                 channel.socket_path(halsdk.core.instance.shm_name(instance))):
         try:
             os.unlink(path)
         except FileNotFoundError:
@@ -644,7 +644,7 @@ def test_attach_to_missing_instance(no_connection):
         halsdk.Hal(name, create=False)
     assert f"no HAL instance '{name}'" in str(err.value)
     assert not os.path.exists(segment_file(name))     # nothing created
-    assert halsdk.instance.current() is None
+    assert halsdk.core.instance.current() is None
 
 
 def test_stale_instance_is_reported_and_cleaned_up(no_connection, spawn,
@@ -659,7 +659,7 @@ def test_stale_instance_is_reported_and_cleaned_up(no_connection, spawn,
         assert dead_host.readline() == f"ready {dead_host.pid}"
         live_host = spawn("host.py", live)
         assert live_host.readline() == f"ready {live_host.pid}"
-        stale_socket = channel.socket_path(halsdk.instance.shm_name(stale))
+        stale_socket = channel.socket_path(halsdk.core.instance.shm_name(stale))
         assert os.path.exists(segment_file(stale))
         assert os.path.exists(stale_socket)
 
@@ -671,7 +671,7 @@ def test_stale_instance_is_reported_and_cleaned_up(no_connection, spawn,
             assert f"'{stale}'" in msg
             assert f"pid {dead_host.pid}" in msg
             assert "halsdk.cleanup()" in msg
-        assert halsdk.instance.current() is None
+        assert halsdk.core.instance.current() is None
 
         # cleanup() scans /dev/shm; let it see only this test's entries, so
         # that it cannot remove what concurrent test runs are creating
@@ -686,7 +686,7 @@ def test_stale_instance_is_reported_and_cleaned_up(no_connection, spawn,
         monkeypatch.setattr(os, "listdir", listdir)
         removed = halsdk.cleanup()
         monkeypatch.undo()
-        assert removed == [halsdk.instance.shm_name(stale)[1:]]
+        assert removed == [halsdk.core.instance.shm_name(stale)[1:]]
         assert not os.path.exists(segment_file(stale))
         assert not os.path.exists(stale_socket)
         assert os.path.exists(segment_file(live))
@@ -698,7 +698,7 @@ def test_stale_instance_is_reported_and_cleaned_up(no_connection, spawn,
         with halsdk.Hal(live, create=False) as other:
             assert not other.is_host
             assert other.info()["host_pid"] == live_host.pid
-        assert halsdk.instance.current() is None
+        assert halsdk.core.instance.current() is None
         live_host.close_stdin()
         assert live_host.readline() == "closed"
         assert live_host.proc.wait(TIMEOUT) == 0
@@ -720,11 +720,11 @@ def test_foreign_segment_is_not_attached(no_connection):
         for create in (False, None, True):
             with pytest.raises(InstanceError) as err:
                 halsdk.Hal(name, create=create)
-            assert halsdk.instance.shm_name(name)[1:] in str(err.value)
+            assert halsdk.core.instance.shm_name(name)[1:] in str(err.value)
             assert "not a halsdk instance" in str(err.value)
         with open(path, "rb") as f:
             assert f.read() == garbage      # left untouched
-        assert halsdk.instance.current() is None
+        assert halsdk.core.instance.current() is None
     finally:
         os.unlink(path)
 
@@ -749,9 +749,9 @@ def test_instance_of_other_abi_version_is_not_attached(no_connection):
         with pytest.raises(InstanceError) as err:
             halsdk.Hal(name, create=False)
         msg = str(err.value)
-        assert halsdk.instance.shm_name(name) in msg
+        assert halsdk.core.instance.shm_name(name) in msg
         assert f"ABI version {other_abi}" in msg
-        assert halsdk.instance.current() is None
+        assert halsdk.core.instance.current() is None
     finally:
         os.unlink(path)
 
@@ -760,7 +760,7 @@ def test_instance_of_other_abi_version_is_not_attached(no_connection):
 
 
 def test_segment_and_channel_permissions(hal):
-    shm = halsdk.instance.shm_name()
+    shm = halsdk.core.instance.shm_name()
     assert shm == f"/halsdk-{os.getuid()}-{hal.instance}"
     seg = os.stat(SHM_DIR + shm)
     assert stat.S_IMODE(seg.st_mode) == 0o600
@@ -784,8 +784,8 @@ def test_idle_client_does_not_block_other_requests(hal):
     import socket as _socket
     import time as _time
 
-    from halsdk import channel
-    shm = halsdk.instance.shm_name(hal.instance)
+    from halsdk.core import channel
+    shm = halsdk.core.instance.shm_name(hal.instance)
     idle = _socket.socket(_socket.AF_UNIX, _socket.SOCK_STREAM)
     idle.connect(channel.socket_path(shm))
     try:

@@ -6,7 +6,7 @@ from __future__ import annotations
 import pytest
 
 import halsdk
-from halsdk import _core
+from halsdk.core import _core
 
 TYPES = ["bit", "float", "s32", "u32", "s64", "u64"]
 

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import halsdk
-from halsdk import _core
+from halsdk.core import _core
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 DATA = os.path.join(HERE, "data", "streams")

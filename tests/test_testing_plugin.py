@@ -63,9 +63,9 @@ def test_plugin_in_another_project(pytester):
         def test_leaks():
             import os, halsdk.testing
             name = halsdk.testing.private_instance_name()
-            halsdk.testing._created.append(halsdk.instance.shm_name(name))
+            halsdk.testing._created.append(halsdk.core.instance.shm_name(name))
             # simulate an instance left behind
-            fd = os.open("/dev/shm" + halsdk.instance.shm_name(name),
+            fd = os.open("/dev/shm" + halsdk.core.instance.shm_name(name),
                          os.O_CREAT | os.O_WRONLY, 0o600)
             os.close(fd)
             open("leaked.txt", "w").write(name)
@@ -75,4 +75,4 @@ def test_plugin_in_another_project(pytester):
     assert result.ret == 1
     result.stdout.fnmatch_lines(["*HAL instances left in /dev/shm*"])
     leaked = (pytester.path / "leaked.txt").read_text()
-    os.unlink("/dev/shm" + halsdk.instance.shm_name(leaked))
+    os.unlink("/dev/shm" + halsdk.core.instance.shm_name(leaked))

@@ -13,7 +13,7 @@ import time
 import pytest
 
 import halsdk
-from halsdk import _core
+from halsdk.core import _core
 
 
 def lowpass(hal, period=1_000_000, tau=0.01):
@@ -283,7 +283,7 @@ def test_no_deadlock_between_gil_mutex_and_python_functions(tmp_path):
     waits for the mutex with the GIL held."""
     script = textwrap.dedent("""
         import os, threading, time, halsdk
-        from halsdk import _core
+        from halsdk.core import _core
         h = halsdk.Hal(f"dl-{os.getpid()}", create=True, size=1 << 22)
         stop = False
         def busy():

@@ -56,7 +56,7 @@ def test_duplicate_thread_undoes_the_load(hal):
 def test_a_threads_own_component_cannot_be_removed(hal):
     hal.newthread("servo", 1_000_000)
     with pytest.raises(halsdk.NotPermittedError, match="belongs to thread"):
-        halsdk._core.comp_exit(hal.component("__servo").id)
+        halsdk.core._core.comp_exit(hal.component("__servo").id)
     hal.step(1)
     assert hal.thread("servo").cycles == 1
     assert hal.pin("servo.time").owner == "__servo"

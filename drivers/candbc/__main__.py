@@ -7,7 +7,7 @@ import sys
 from collections.abc import Sequence
 from typing import Optional
 
-from halsdk.driver import IOLoop
+from halsdk.driverkit import IOLoop
 
 from .dbc import ConfigError
 from .driver import CanDbcDriver

@@ -11,13 +11,13 @@ from typing import Any, Callable, Optional
 import can
 from cantools.database.can import Message
 
-from halsdk.driver import Driver, DriverError
+from halsdk.driverkit import Driver, DriverError
 
 from .dbc import ConfigError, SignalPin
 from .names import NameClash, unique_names
 from .options import Config
 
-log = logging.getLogger("halsdk.driver")
+log = logging.getLogger("halsdk.driverkit")
 
 #: per-message pins that signals may not take
 RESERVED = ("timeout", "count")

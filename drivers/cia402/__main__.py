@@ -8,9 +8,10 @@ import logging
 import sys
 from typing import Optional
 
-from halsdk.driver import IOLoop
-from halsdk.drivers.cia402.config import ConfigError, load
-from halsdk.drivers.cia402.driver import Cia402Driver
+from halsdk.driverkit import IOLoop
+
+from .config import ConfigError, load
+from .driver import Cia402Driver
 
 PROGRAM = "cia402"
 

@@ -13,9 +13,10 @@ import can
 import canopen
 from canopen.objectdictionary import ObjectDictionary, ODVariable
 
-from halsdk.drivers.cia402 import DEFAULT_EDS
-from halsdk.drivers.cia402.statemachine import MODES
 from halsdk.ini import IniFile
+
+from . import DEFAULT_EDS
+from .statemachine import MODES
 
 BUS = "BUS"
 BUS_KEYS = {"INTERFACE", "CHANNEL", "BITRATE", "PERIOD", "SIMULATE",

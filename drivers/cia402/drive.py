@@ -15,10 +15,11 @@ import canopen
 from canopen.sdo import SdoAbortedError, SdoClient, SdoCommunicationError
 
 from halsdk.component import Component
-from halsdk.driver.backoff import Backoff
-from halsdk.drivers.cia402 import statemachine as sm
-from halsdk.drivers.cia402.codes import abort_text, emcy_text
-from halsdk.drivers.cia402.config import DriveConfig, PdoEntry
+from halsdk.driverkit.backoff import Backoff
+
+from . import statemachine as sm
+from .codes import abort_text, emcy_text
+from .config import DriveConfig, PdoEntry
 
 log = logging.getLogger("halsdk.drivers.cia402")
 

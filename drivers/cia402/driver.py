@@ -11,10 +11,11 @@ from typing import Optional
 import can
 import canopen
 
-from halsdk.driver import Driver
-from halsdk.drivers.cia402.config import BusConfig
-from halsdk.drivers.cia402.drive import DriveLink
-from halsdk.drivers.cia402.sim import SimBus, SimDrive
+from halsdk.driverkit import Driver
+
+from .config import BusConfig
+from .drive import DriveLink
+from .sim import SimBus, SimDrive
 
 log = logging.getLogger("halsdk.drivers.cia402")
 

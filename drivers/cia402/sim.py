@@ -21,8 +21,8 @@ import can
 import canopen
 from canopen.objectdictionary import ODVariable
 
-from halsdk.drivers.cia402 import DEFAULT_EDS
-from halsdk.drivers.cia402 import statemachine as sm
+from . import DEFAULT_EDS
+from . import statemachine as sm
 
 log = logging.getLogger("halsdk.drivers.cia402.sim")
 

@@ -1,7 +1,7 @@
 """mb2hal: a userspace HAL component that exchanges values with Modbus
 devices (TCP or RTU), configured by a reference-compatible INI file."""
 
-from halsdk.drivers.mb2hal.config import (
+from .config import (
     FUNCTIONS,
     Config,
     ConfigError,
@@ -9,7 +9,7 @@ from halsdk.drivers.mb2hal.config import (
     Transaction,
     load_config,
 )
-from halsdk.drivers.mb2hal.engine import Mb2hal
+from .engine import Mb2hal
 
 __all__ = ["FUNCTIONS", "Config", "ConfigError", "Link", "Transaction",
            "load_config", "Mb2hal"]

@@ -9,9 +9,10 @@ import sys
 from collections.abc import Sequence
 from typing import Optional
 
-from halsdk.drivers.mb2hal.config import ConfigError, load_config
-from halsdk.drivers.mb2hal.engine import Mb2hal
 from halsdk.errors import HalError
+
+from .config import ConfigError, load_config
+from .engine import Mb2hal
 
 LEVELS = {0: logging.CRITICAL + 1, 1: logging.WARNING, 2: logging.INFO,
           3: logging.DEBUG, 4: logging.DEBUG}

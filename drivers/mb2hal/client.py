@@ -8,7 +8,7 @@ import re
 from collections.abc import Sequence
 from typing import Any, Optional
 
-from halsdk.drivers.mb2hal.config import PARITIES, Link, Transaction
+from .config import PARITIES, Link, Transaction
 
 # pymodbus reports every refused connect at ERROR level; mb2hal reports
 # link problems itself, once per outage.

@@ -10,9 +10,10 @@ import time
 from typing import Callable, Optional
 
 from halsdk.component import Component, component
-from halsdk.driver.backoff import Backoff
-from halsdk.drivers.mb2hal.client import LinkDown, ModbusLink, Refused
-from halsdk.drivers.mb2hal.config import VERSION_1_1, Config, Link, Transaction
+from halsdk.driverkit.backoff import Backoff
+
+from .client import LinkDown, ModbusLink, Refused
+from .config import VERSION_1_1, Config, Link, Transaction
 
 log = logging.getLogger("halsdk.mb2hal")
 

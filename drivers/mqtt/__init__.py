@@ -2,8 +2,8 @@
 pins from subscribed topics (programs ``mqtt-publisher`` and
 ``mqtt-bridge``)."""
 
-from halsdk.drivers.mqtt.bridge import Bridge
-from halsdk.drivers.mqtt.config import BridgeConfig, ConfigError
-from halsdk.drivers.mqtt.payload import PayloadError
+from .bridge import Bridge
+from .config import BridgeConfig, ConfigError
+from .payload import PayloadError
 
 __all__ = ["Bridge", "BridgeConfig", "ConfigError", "PayloadError"]

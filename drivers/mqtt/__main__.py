@@ -8,9 +8,10 @@ import sys
 from collections.abc import Sequence
 from typing import Optional
 
-from halsdk.drivers.mqtt.bridge import Bridge
-from halsdk.drivers.mqtt.config import ConfigError, parse_args
 from halsdk.errors import HalError
+
+from .bridge import Bridge
+from .config import ConfigError, parse_args
 
 
 def _named(prog: str, exc: Exception) -> str:

@@ -11,14 +11,15 @@ import time
 from dataclasses import dataclass
 from typing import Any, Callable, Optional
 
-from halsdk import _core
 from halsdk.component import Component, component
-from halsdk.drivers.mqtt import payload
-from halsdk.drivers.mqtt.client import Link
-from halsdk.drivers.mqtt.config import BridgeConfig, ConfigError, Subscription, check
+from halsdk.core import _core
 from halsdk.errors import HalError
 
-log = logging.getLogger("halsdk.driver.mqtt")
+from . import payload
+from .client import Link
+from .config import BridgeConfig, ConfigError, Subscription, check
+
+log = logging.getLogger("halsdk.driverkit.mqtt")
 
 #: values of the fault-code pin
 FAULT_NONE, FAULT_CONNECT, FAULT_REFUSED, FAULT_LOST = 0, 1, 2, 3

@@ -11,7 +11,7 @@ from typing import Any, Optional
 import paho.mqtt.client as mqtt
 from paho.mqtt.enums import CallbackAPIVersion
 
-from halsdk.drivers.mqtt.config import BridgeConfig, ConfigError
+from .config import BridgeConfig, ConfigError
 
 #: events: ("up",), ("refused", words), ("fail", words), ("lost", words),
 #: ("msg", topic, payload)

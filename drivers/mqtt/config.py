@@ -10,7 +10,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Optional
 
-from halsdk.drivers.mqtt.payload import TYPES
+from .payload import TYPES
 
 
 class ConfigError(Exception):

@@ -1,8 +1,8 @@
 """Userspace driver for the XHC WHB04B-6/-4 wireless USB jog pendant."""
 
-from halsdk.drivers.whb04b.driver import Whb04bDriver
-from halsdk.drivers.whb04b.fake import FakeBackend, ScriptError, load_script
-from halsdk.drivers.whb04b.protocol import (
+from .driver import Whb04bDriver
+from .fake import FakeBackend, ScriptError, load_script
+from .protocol import (
     BUTTON_NAMES,
     Report,
     ReportError,

@@ -10,10 +10,11 @@ from collections.abc import Sequence
 from importlib import resources
 from typing import Optional
 
-from halsdk.driver import IOLoop
-from halsdk.drivers.whb04b.driver import Whb04bDriver
-from halsdk.drivers.whb04b.fake import FakeBackend, ScriptError, load_script
-from halsdk.drivers.whb04b.protocol import PRODUCT_ID
+from halsdk.driverkit import IOLoop
+
+from .driver import Whb04bDriver
+from .fake import FakeBackend, ScriptError, load_script
+from .protocol import PRODUCT_ID
 
 DEMO = "demo"
 #: longest loop period: USB reads wait up to a quarter of it, and a stop

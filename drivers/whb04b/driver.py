@@ -10,8 +10,9 @@ from typing import Any, Callable, Optional
 import usb.core
 import usb.util
 
-from halsdk.driver import Driver, DriverError
-from halsdk.drivers.whb04b.protocol import (
+from halsdk.driverkit import Driver, DriverError
+
+from .protocol import (
     AXIS_NAMES,
     BUTTON_NAMES,
     LEAD_POSITION,
@@ -32,7 +33,7 @@ from halsdk.drivers.whb04b.protocol import (
     parse_report,
 )
 
-log = logging.getLogger("halsdk.driver")
+log = logging.getLogger("halsdk.driverkit")
 
 INTERFACE = 0
 READ_SIZE = 64            # more than a report, so long ones are seen

@@ -32,7 +32,7 @@ from typing import Callable, Optional, Union
 import usb.backend
 import usb.core
 
-from halsdk.drivers.whb04b.protocol import PRODUCT_ID, VENDOR_ID
+from .protocol import PRODUCT_ID, VENDOR_ID
 
 IN_ENDPOINT = 0x81
 #: longest ``pause`` of a replay file, in seconds

@@ -16,7 +16,7 @@
 # the inputs at the end of every write (see sim_hardware).
 
 from halsdk cimport hal
-from halsdk.driver cimport rt
+from halsdk.driverkit cimport rt
 
 hal.import_halsdk()
 

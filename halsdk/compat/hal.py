@@ -32,8 +32,8 @@ import threading
 from typing import Any, Optional, Union
 
 import halsdk
-from halsdk import _core
-from halsdk import instance as _instance
+from halsdk.core import _core
+from halsdk.core import instance as _instance
 from halsdk.errors import HalError, InvalidError, StaleError
 
 __all__ = [
@@ -145,7 +145,7 @@ def _install_sigterm() -> None:
         return
     current = _signal.getsignal(_signal.SIGTERM)
     if current in (_signal.SIG_DFL, None) or getattr(
-            current, "__module__", None) == "halsdk.instance":
+            current, "__module__", None) == "halsdk.core.instance":
         _signal.signal(_signal.SIGTERM, _signal.default_int_handler)
 
 

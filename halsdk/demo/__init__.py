@@ -1,7 +1,7 @@
 """The halsdk demo: a simulated three-axis servo mill runs a short program.
 
 Run it with ``halsdk-demo`` (or ``python -m halsdk.demo``).  It starts the
-example machine ``examples/mill`` (installed as ``halsdk.demo.mill``) from
+example machine ``halsdk/demo/mill`` (package data of ``halsdk.demo``) from
 its INI file, turns it on, homes it, runs ``demo.ngc`` (two tool changes,
 feed lines, an arc and a probe), prints a summary and writes a plot.
 
@@ -48,15 +48,13 @@ class Summary:
 
 
 def machine_folder() -> Path:
-    """The folder of mill.ini: the installed package data (the folder
-    ``mill`` next to this file, i.e. ``halsdk.demo.mill``), or
-    examples/mill of a source checkout."""
-    here = Path(__file__).resolve().parent
-    for folder in (here / "mill", here.parents[1] / "examples" / "mill"):
-        if (folder / "mill.ini").is_file():
-            return folder
-    raise FileNotFoundError(f"the demo's machine (mill.ini) is neither in "
-                            f"{here / 'mill'} nor in a source checkout")
+    """The folder of mill.ini: ``mill`` next to this file (package data
+    of ``halsdk.demo``, the same in a checkout and installed)."""
+    folder = Path(__file__).resolve().parent / "mill"
+    if not (folder / "mill.ini").is_file():
+        raise FileNotFoundError(f"the demo's machine is missing: no "
+                                f"{folder / 'mill.ini'}")
+    return folder
 
 
 class _Recorder:
@@ -151,8 +149,8 @@ def run(out_png: Optional[str] = "demo.png", realtime: bool = False,
         out: TextIO = sys.stdout) -> Summary:
     """Run the demo; returns its :class:`Summary` (also printed to
     ``out``).  ``out_png`` None: no plot."""
-    from halsdk.launcher import Launcher
     from halsdk.machine import Machine, TaskMode, TaskState
+    from halsdk.machine.launcher import Launcher
 
     folder = machine_folder()
     ini = folder / "mill.ini"

@@ -14,7 +14,7 @@ Conventions
   the way the developer manual's tool section describes, and the matching
   canon commands let the machine layer update its copy.
 * Cutter radius compensation (G41/G42 with D = tool number, radius from
-  the tool table) covers straight moves in G17; see interp_comp for what
+  the tool table) covers straight moves in G17; see cutter_radius for what
   is refused.
 * G84 is the floating-chuck tap of the reference manual: feed in, spindle
   reversed for a feed out at the same rate, no spindle synchronisation;
@@ -32,7 +32,7 @@ from typing import Any, Optional
 
 from . import canon as C
 from .block import Block, code_key
-from .interp_comp import CompError, CutterComp
+from .cutter_radius import CutterComp, CutterRadiusError
 from .modal import AXIS_USERS_GROUP0, ModalState, group_codes
 
 AXES = "xyzabcuvw"
@@ -396,7 +396,7 @@ class Interpreter:
             radius = entry.diameter / 2 if entry is not None else 0.0
             try:
                 self.comp.start(1 if code == 410 else -1, radius)
-            except CompError as e:
+            except CutterRadiusError as e:
                 raise block.error(str(e), key) from None
         self.modal.cutter_comp = code
 
@@ -675,7 +675,7 @@ class Interpreter:
                 feed = self._feed_for(block, math.dist(self.pos, end))
             try:
                 self.comp.move(self.pos, end, feed, line)
-            except CompError as e:
+            except CutterRadiusError as e:
                 raise block.error(str(e), key) from None
             self.pos = end
             return

@@ -38,7 +38,7 @@ import sys
 from dataclasses import dataclass
 from typing import Optional
 
-from halsdk import _core
+from halsdk.core import _core
 from halsdk.halcmd.commands import ARROWS, REFERENCE_NAME_LEN, Executor
 
 _NAME_OK = re.compile(r"[a-z0-9._-]+")

@@ -130,7 +130,7 @@ def _die(prog: str, message: str, usage: str) -> None:
 
 def _completions(text: str, first_word: bool) -> list[str]:
     """Command names for the first word, HAL names after it."""
-    from halsdk import _core
+    from halsdk.core import _core
     from halsdk.halcmd.commands import ARG_COUNTS
     if first_word:
         names = list(ARG_COUNTS)
@@ -246,7 +246,7 @@ def _check(opts: _Options, prog: str) -> int:
 
 def _teardown(hal, ex: Executor, opts: _Options) -> None:
     """What the end of halrun does: stop threads, end loadusr programs."""
-    from halsdk import _core
+    from halsdk.core import _core
     from halsdk.errors import HalError
     if _core.get_lock() & 8:
         # the reference's teardown cannot stop threads under a run lock

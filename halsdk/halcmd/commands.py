@@ -16,7 +16,7 @@ import time
 from collections.abc import Iterable
 from typing import Callable, Optional
 
-from halsdk import _core
+from halsdk.core import _core
 from halsdk.errors import HalError
 from halsdk.halcmd.helptext import HELP
 from halsdk.halcmd.lexer import (

@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import Callable
 
-from halsdk import _core
+from halsdk.core import _core
 from halsdk.halcmd.show import sorted_items, threads, type_name, value_cell
 
 Out = Callable[[str], None]

@@ -13,7 +13,7 @@ import os
 from collections.abc import Sequence
 from typing import Any, Callable
 
-from halsdk import _core
+from halsdk.core import _core
 
 Out = Callable[[str], None]
 NAME_LEN = 47

@@ -2,7 +2,7 @@
  * halsdk_api.h - the C API that compiled components use.
  *
  * The core exports one table of function pointers behind the capsule
- * "halsdk._core._C_API".  A component module fills its copy of the table
+ * "halsdk.core._core._C_API".  A component module fills its copy of the table
  * pointer once at import time (import_halsdk()) and then calls the API at
  * C speed.  hal.h and rtapi.h are thin inline wrappers over this table.
  *
@@ -22,7 +22,7 @@ extern "C" {
 #endif
 
 #define HALSDK_API_VERSION 4
-#define HALSDK_CAPSULE_NAME "halsdk._core._C_API"
+#define HALSDK_CAPSULE_NAME "halsdk.core._core._C_API"
 
 /* longest object name, not counting the terminating NUL */
 #define HALSDK_NAME_LEN 127
@@ -176,7 +176,7 @@ const halsdk_api *halsdk_api_ptr;
 /* Fill the table pointer; returns 0, or -1 with a Python error set. */
 static inline int import_halsdk(void)
 {
-    PyObject *mod = PyImport_ImportModule("halsdk._core");
+    PyObject *mod = PyImport_ImportModule("halsdk.core._core");
     if (!mod)
         return -1;
     Py_DECREF(mod);

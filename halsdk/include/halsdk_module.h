@@ -2,7 +2,7 @@
  * halsdk_module.h - the table of module parameters of a C component.
  *
  * Filled by the RTAPI_MP_* constructors when the module is loaded; read by
- * the module's Python entry (halsdk/src/c_module.c) to apply the
+ * the module's Python entry (halsdk/core/src/c_module.c) to apply the
  * parameters of a loadrt line before rtapi_app_main() runs.
  */
 #ifndef HALSDK_MODULE_H

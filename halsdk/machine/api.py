@@ -19,8 +19,8 @@ from typing import Any, Optional
 
 from halsdk.errors import HalError
 from halsdk.gcode import GCodeError, Parameters, Program
+from halsdk.gcode.cutter_radius import CutterComp
 from halsdk.gcode.interp import Interpreter
-from halsdk.gcode.interp_comp import CutterComp
 from halsdk.machine.executor import Executor
 from halsdk.machine.iocontrol import IoControl
 from halsdk.machine.task import InterpState, MachineError, Task, TaskMode, TaskState
@@ -99,7 +99,7 @@ class Machine:
     @classmethod
     def from_launcher(cls, launcher: Any, io: Optional[IoControl] = None,
                       thread: str = "servo-thread") -> Machine:
-        """A machine for a started :class:`halsdk.launcher.Launcher`:
+        """A machine for a started :class:`halsdk.machine.launcher.Launcher`:
         the tool table from [EMCIO]TOOL_TABLE (RANDOM_TOOLCHANGER),
         units from [TRAJ]LINEAR_UNITS."""
         ini = launcher.ini

@@ -167,9 +167,9 @@ cdef const halsdk_api *_api = NULL
 cdef const halsdk_api *get_api() except NULL:
     global _api
     if _api == NULL:
-        from halsdk import _core
+        from halsdk.core import _core
         _api = <const halsdk_api *>PyCapsule_GetPointer(
-            _core._C_API, b"halsdk._core._C_API")
+            _core._C_API, b"halsdk.core._core._C_API")
         if _api.version < 4:
             _api = NULL
             raise ChannelError("the halsdk core is too old for the motion "
@@ -248,7 +248,7 @@ cdef class Channel:
 
     def __init__(self, str name, int pid):
         cdef const halsdk_api *api = get_api()
-        from halsdk import _core
+        from halsdk.core import _core
         addr, size = _core.shmem_attach(name)    # NotFoundError if none
         cdef bytes b = name.encode()
         self.handle = api.shmem_attach(b)

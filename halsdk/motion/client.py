@@ -23,7 +23,7 @@ import time
 from collections.abc import Iterable, Mapping, Sequence
 from typing import Any, Callable, Optional, Union
 
-from halsdk import _core
+from halsdk.core import _core
 from halsdk.errors import HalError, NotFoundError
 from halsdk.motion import _channel
 from halsdk.motion.status import (

@@ -139,7 +139,7 @@ def parse_args(argv: Sequence[str]) -> Options:
 
 def format_value(hal_type: int, value: Any) -> str:
     """The value as the reference meter displays it."""
-    from halsdk import _core
+    from halsdk.core import _core
     if hal_type == _core.BIT:
         return "TRUE" if value else "FALSE"
     if hal_type == _core.FLOAT:
@@ -157,7 +157,7 @@ def format_value(hal_type: int, value: Any) -> str:
 
 def _find(kind: str, name: str):
     """The handle of the watched item, or None."""
-    from halsdk import _core
+    from halsdk.core import _core
     return _core.find(_KINDS[kind], name)
 
 

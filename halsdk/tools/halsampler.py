@@ -81,7 +81,7 @@ def copy_records(stream, out: IO[str], count: int, tag: bool,
                  stop: list) -> int:
     """Copy records to ``out`` until ``count`` were printed (forever when
     negative) or ``stop`` becomes non-empty; returns the number printed."""
-    from halsdk import _core
+    from halsdk.core import _core
     types = stream.types
     floats = [t == _core.FLOAT for t in types]
     names = [f"v{i}" for i in range(len(types))]
@@ -127,7 +127,8 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         return 1
     stop = stop_on_signals()
 
-    from halsdk import _core, errors
+    from halsdk import errors
+    from halsdk.core import _core
     hal = attach(PROG)
     if hal is None:
         return 1

@@ -81,7 +81,7 @@ def _c_unsigned(tok: str, bits: int) -> int:
 def parse_line(line: str, types: Sequence[int]) -> list:
     """Values of one input line for a channel of ``types``; raises
     :class:`LineError` the way the reference rejects a line."""
-    from halsdk import _core
+    from halsdk.core import _core
     values = []
     pos, end = 0, len(line)
     for i, t in enumerate(types):
@@ -191,7 +191,8 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         return 1
     stop = stop_on_signals()
 
-    from halsdk import _core, errors
+    from halsdk import errors
+    from halsdk.core import _core
     hal = attach(PROG)
     if hal is None:
         return 1

@@ -6,7 +6,7 @@ function ``iopin`` (does nothing).
 
 from __future__ import annotations
 
-from halsdk import _core
+from halsdk.core import _core
 
 _comp_id = -1
 

@@ -23,7 +23,7 @@ import os
 import sys
 
 import halsdk
-from halsdk import _core
+from halsdk.core import _core
 
 
 def plain(value):

@@ -9,8 +9,8 @@ import threading
 import time
 from typing import Callable, Optional
 
-from halsdk.driver.backoff import Backoff
-from halsdk.driver.base import (
+from halsdk.driverkit.backoff import Backoff
+from halsdk.driverkit.base import (
     FAULT_OPEN,
     FAULT_READ,
     FAULT_WRITE,

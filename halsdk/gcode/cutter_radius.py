@@ -7,7 +7,7 @@ through.  The first XY move after G41/G42 is the entry move: it runs straight
 from where the tool is to the offset start of the next corner.  G40 ends the
 offset after the last segment; the following move is the exit move.
 
-Refused with :class:`CompError`: arcs, canned cycles, probing and G33 while
+Refused with :class:`CutterRadiusError`: arcs, canned cycles, probing and G33 while
 compensation is on, other planes, an inside corner right after a non-XY move,
 and segments too short for the tool radius (they would gouge).
 """
@@ -21,7 +21,7 @@ from typing import Callable, Optional
 from . import canon as C
 
 
-class CompError(Exception):
+class CutterRadiusError(Exception):
     """A program that cutter compensation cannot handle."""
 
 
@@ -58,9 +58,9 @@ class CutterComp:
 
     def start(self, side: int, radius: float) -> None:
         if self.active:
-            raise CompError("cutter compensation is already on (G40 first)")
+            raise CutterRadiusError("cutter compensation is already on (G40 first)")
         if radius < 0:
-            raise CompError("negative tool radius for cutter compensation")
+            raise CutterRadiusError("negative tool radius for cutter compensation")
         self.side, self.radius = side, radius
         self._last_dir = None
         self._at = None
@@ -150,7 +150,7 @@ class CutterComp:
             self._at = b_start
         else:                                         # inside corner
             if self._pending is None:
-                raise CompError("inside corner right after a non-XY move "
+                raise CutterRadiusError("inside corner right after a non-XY move "
                                 "under cutter compensation is not supported")
             # a_off + t*prev == b_off + s*d
             ax, ay = corner[0] + off_a[0], corner[1] + off_a[1]
@@ -158,7 +158,7 @@ class CutterComp:
             t = (rx * d[1] - ry * d[0]) / cross
             s = (rx * prev[1] - ry * prev[0]) / cross
             if -t > self._pending.length + 1e-9 or s > new.length + 1e-9:
-                raise CompError("segment too short for the tool radius "
+                raise CutterRadiusError("segment too short for the tool radius "
                                 "(cutter compensation would gouge)")
             point = (ax + t * prev[0], ay + t * prev[1])
             self._finish_pending(point)

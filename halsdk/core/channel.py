@@ -23,7 +23,7 @@ import struct
 import threading
 from typing import Any
 
-from halsdk import errors
+from halsdk.core import errors
 
 _MAX_REQUEST = 1 << 20
 

@@ -18,7 +18,7 @@ def main(argv: Optional[list[str]] = None) -> int:
                           "until Ctrl-C or SIGTERM)")
     a = p.parse_args(sys.argv[1:] if argv is None else argv)
     if a.command == "run":
-        from halsdk.launcher import run as run_machine
+        from halsdk.machine.launcher import run as run_machine
         return run_machine(a.ini, seconds=a.seconds)
     return 2
 

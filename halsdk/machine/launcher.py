@@ -149,7 +149,7 @@ class Launcher:
                               "message above)")
 
     def _configure_motion(self) -> None:
-        from halsdk import _core
+        from halsdk.core import _core
         try:
             _core.shmem_attach("motmod.channel")
         except HalError:

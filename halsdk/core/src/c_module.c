@@ -224,7 +224,7 @@ static int set_param(halsdk_modparam_t *m, PyObject *v)
     return 0;
 }
 
-/* the halsdk.errors class that fits the errno rtapi_app_main returned */
+/* the halsdk.core.errors class that fits the errno rtapi_app_main returned */
 static const char *error_class(int r)
 {
     switch (r < 0 ? -r : r) {
@@ -268,7 +268,7 @@ static void setup_failed(int r, const char *msgs, const char *hal_error)
     if (!n)
         snprintf(text, sizeof(text), "rtapi_app_main() returned %d (%s)",
                  r, strerror(r < 0 ? -r : r));
-    PyObject *errors = PyImport_ImportModule("halsdk.errors");
+    PyObject *errors = PyImport_ImportModule("halsdk.core.errors");
     PyObject *cls = errors ? PyObject_GetAttrString(errors, error_class(r))
                            : NULL;
     Py_XDECREF(errors);

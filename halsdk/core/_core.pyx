@@ -18,7 +18,7 @@ import re
 import sys
 import traceback
 
-from halsdk import errors as _errors
+from halsdk.core import errors as _errors
 
 cdef extern from "hal_core.h" nogil:
     ctypedef uint32_t hoff_t
@@ -262,7 +262,7 @@ TYPE_NAMES = {BIT: "bit", FLOAT: "float", S32: "s32", U32: "u32",
 DIR_NAMES = {IN: "IN", OUT: "OUT", IO: "I/O", RO: "RO", RW: "RW"}
 
 _C_API = PyCapsule_New(<void *>&halsdk_api_table,
-                       b"halsdk._core._C_API", NULL)
+                       b"halsdk.core._core._C_API", NULL)
 
 _ERRNO_CLASS = {
     2: _errors.NotFoundError,        # ENOENT

@@ -1,7 +1,7 @@
 # Realtime driver helpers: the canonical channels for Cython components.
 #
 #     from halsdk cimport hal
-#     from halsdk.driver cimport rt
+#     from halsdk.driverkit cimport rt
 #     hal.import_halsdk()          # once, at module level, as usual
 #
 # Each channel is a struct that lives in HAL shared memory (allocate it

@@ -15,8 +15,8 @@ import threading
 import time
 from typing import Callable, Optional
 
-from halsdk import _core
-from halsdk.errors import ExistsError, InstanceError, InvalidError
+from halsdk.core import _core
+from halsdk.core.errors import ExistsError, InstanceError, InvalidError
 
 _INSTANCE_NAME = re.compile(r"^[A-Za-z0-9_.-]{1,40}$")
 SHM_DIR = "/dev/shm"
@@ -95,7 +95,7 @@ def connect(instance: Optional[str] = None, create: Optional[bool] = None,
         conn.users = 1
         _conn = conn
         if conn.host:
-            from halsdk import channel
+            from halsdk.core import channel
             try:
                 conn.server = channel.Server(conn)
             except Exception:
@@ -225,7 +225,7 @@ def cleanup(instance: Optional[str] = None) -> list[str]:
     the shared-memory segments removed.  Instances with a live host are
     left alone.
     """
-    from halsdk import channel
+    from halsdk.core import channel
 
     prefix = f"halsdk-{os.getuid()}"
     if instance is not None:

@@ -8,9 +8,9 @@ from collections.abc import Sequence
 from typing import Optional
 
 from halsdk.component import Component, component
-from halsdk.driver.canonical import AdcIn, DacOut, DigIn, DigOut, Encoder
+from halsdk.driverkit.canonical import AdcIn, DacOut, DigIn, DigOut, Encoder
 
-log = logging.getLogger("halsdk.driver")
+log = logging.getLogger("halsdk.driverkit")
 
 #: values of the ``fault-code`` pin
 FAULT_NONE = 0
@@ -43,7 +43,7 @@ class Driver:
     ``fault`` (bit), ``fault-code`` (u32, one of ``FAULT_*``),
     ``fault-count`` (u32, faults since start) and ``connected`` (bit), calls
     :meth:`setup` and marks the component ready.  A loop
-    (:class:`halsdk.driver.IOLoop`) then drives the device.
+    (:class:`halsdk.driverkit.IOLoop`) then drives the device.
     """
 
     name = "driver"
