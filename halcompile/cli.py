@@ -42,6 +42,7 @@ from typing import Optional
 from halcompile.gen_c import MAX_PERSONALITIES, generate
 from halcompile.model import Component
 from halcompile.parser import CompError, parse_file
+from halcompile.sources import generate_source
 
 #: flags of every generated module: its symbols stay private to it
 _PRIVATE = ["-fvisibility=hidden"]
@@ -197,22 +198,19 @@ def _build(path: str, comp: Optional[Component], mode: str,
                                    extra_compile_args=flags,
                                    extra_link_args=list(ldflags))
         else:
-            flags += shlex.split(str(comp.option("extra_compile_args",
-                                                 "")))
-            ldflags = list(ldflags) + shlex.split(
-                str(comp.option("extra_link_args", "")))
             deps = _local_headers_digest(comp, includes[0])
             if deps:
                 flags.append(f"-DHALCOMPILE_DEPS=0x{deps}")
             with tempfile.TemporaryDirectory(prefix="halcompile-") as tmp:
-                c_file = os.path.join(tmp, comp.name + ".c")
-                with open(c_file, "w", encoding="utf-8") as f:
-                    f.write(generate(comp, comp.name + ".c", personalities))
-                dest = build_component(c_file, out_dir=out_dir,
+                src = generate_source(comp, tmp, personalities,
+                                      c_filename=comp.name + ".c")
+                dest = build_component(src.path, out_dir=out_dir,
                                        name=comp.name,
                                        include_dirs=includes,
-                                       extra_compile_args=flags,
-                                       extra_link_args=list(ldflags))
+                                       extra_compile_args=flags
+                                       + src.compile_args,
+                                       extra_link_args=list(ldflags)
+                                       + src.link_args)
     except BuildError as exc:
         lines = str(exc).splitlines()
         body = "\n".join(ln for ln in lines[1:] if not _NOISE.search(ln)) \
@@ -233,37 +231,36 @@ def _cython(path: str, comp: Component, mode: str, output: Optional[str],
     from halsdk.build import BuildError, build_component
     from halsdk.loader import user_component_dir
 
-    try:
-        text, origin = gen_cython.generate(comp)
-    except gen_cython.CythonSourceError as exc:
-        with open(path, encoding="utf-8") as f:
-            lines = f.read().split("\n")
-        shown = lines[exc.line - 1] if 0 < exc.line <= len(lines) else None
-        raise CompError(Loc(comp.file, exc.line, 1), exc.message,
-                        shown) from None
-    if mode == "preprocess":
-        out = output or os.path.splitext(path)[0] + ".pyx"
-        with open(out, "w", encoding="utf-8") as f:
-            f.write(text)
-        return out
     out_dir = user_component_dir() if mode == "install" else \
         (output or os.getcwd())
-    flags = _PRIVATE + list(cflags) + shlex.split(
-        str(comp.option("extra_compile_args", "")))
-    ldflags = list(ldflags) + shlex.split(
-        str(comp.option("extra_link_args", "")))
     with tempfile.TemporaryDirectory(prefix="halcompile-") as tmp:
-        pyx = os.path.join(tmp, comp.name + ".pyx")
-        with open(pyx, "w", encoding="utf-8") as f:
-            f.write(text)
+        try:
+            src = generate_source(comp, tmp)
+        except gen_cython.CythonSourceError as exc:
+            with open(path, encoding="utf-8") as f:
+                lines = f.read().split("\n")
+            shown = lines[exc.line - 1] if 0 < exc.line <= len(lines) \
+                else None
+            raise CompError(Loc(comp.file, exc.line, 1), exc.message,
+                            shown) from None
+        if mode == "preprocess":
+            out = output or os.path.splitext(path)[0] + ".pyx"
+            with open(src.path, encoding="utf-8") as f:
+                text = f.read()
+            with open(out, "w", encoding="utf-8") as f:
+                f.write(text)
+            return out
         try:
             dest = build_component(
-                pyx, out_dir=out_dir, name=comp.name,
+                src.path, out_dir=out_dir, name=comp.name,
                 include_dirs=[os.path.dirname(os.path.abspath(path))],
-                extra_compile_args=flags, extra_link_args=ldflags)
+                extra_compile_args=_PRIVATE + list(cflags)
+                + src.compile_args,
+                extra_link_args=list(ldflags) + src.link_args)
         except BuildError as exc:
             raise _Failed(f"{path}: compilation failed:\n"
-                          + _map_pyx_lines(str(exc), comp, origin)) from None
+                          + _map_pyx_lines(str(exc), comp, src.origin)
+                          ) from None
     print(dest)
     return dest
 

@@ -3,7 +3,7 @@
 A ``.comp`` with ``option userspace yes`` (or a hand-written C program
 built with ``halcompile --compile -u prog.c``) becomes a program that
 ``loadusr`` starts.  halsdk has no shared C library for its core (the C
-API lives in a capsule of the Python extension ``halsdk._core``), so the
+API lives in a capsule of the Python extension ``halsdk.core._core``), so the
 program is made of two files, both written by ``halcompile --compile``:
 
 ``NAME<ext>``
@@ -28,24 +28,18 @@ and then remove the component of the dead process.  When
 ``user_mainloop`` returns, the component is removed and the program ends
 with status 0.
 
-``python -m halcompile.gen_user MODULE_FILE args...`` runs a module
-without a launcher script.
+The launcher calls :func:`halsdk.userspace.run`, the runtime that lives in
+halsdk: halcompile is needed to build a program, never to run one.
 """
 
 from __future__ import annotations
 
-import importlib.util
 import os
-import signal
 import stat
 import sys
-from collections.abc import Sequence
-from typing import Optional
 
-#: most command-line words a userspace program receives
-MAX_ARGS = 256
-#: the module parameter that carries the command line
-ARGV_PARAM = "halsdk_argv"    # halsdk.loader.USER_ARGV_PARAM
+from halsdk.loader import USER_ARGV_PARAM as ARGV_PARAM
+from halsdk.userspace import MAX_ARGS
 
 
 def app_main(w, comp) -> None:   # w: gen_c._Writer, comp: Component
@@ -177,7 +171,7 @@ def launcher_script(name: str, module_path: str) -> str:
             f"# {name}: starts the userspace HAL component {name} "
             "(written by halcompile)\n"
             "import os\nimport sys\n\n"
-            "from halcompile.gen_user import run\n\n"
+            "from halsdk.userspace import run\n\n"
             f"MODULE = {os.path.basename(module_path)!r}\n"
             f"INSTALLED = {os.path.abspath(module_path)!r}\n"
             "here = os.path.join(os.path.dirname(os.path.realpath("
@@ -204,65 +198,3 @@ def user_bin_dir() -> str:
     components: ``$XDG_BIN_HOME`` or ``~/.local/bin``."""
     return os.environ.get("XDG_BIN_HOME") or os.path.join(
         os.path.expanduser("~"), ".local", "bin")
-
-
-def run(module_path: str, argv: Sequence[str]) -> int:
-    """Run the userspace component module at ``module_path`` with the
-    command line ``argv`` (``argv[0]``: the program name); returns the
-    exit status."""
-    from halsdk import instance
-    from halsdk.errors import HalError
-
-    name = os.path.basename(module_path).split(".")[0]
-    prog = os.path.basename(argv[0]) if argv else name
-    try:
-        conn = instance.connect(None, create=False)
-    except HalError as exc:
-        print(f"{prog}: {exc}", file=sys.stderr)
-        return 1
-    spec = importlib.util.spec_from_file_location(name, module_path)
-    if spec is None or spec.loader is None:
-        print(f"{prog}: cannot load {module_path}", file=sys.stderr)
-        return 1
-    module = importlib.util.module_from_spec(spec)
-    try:
-        spec.loader.exec_module(module)
-    except Exception as exc:
-        print(f"{prog}: {module_path}: {exc}", file=sys.stderr)
-        return 1
-    # like a C program: SIGINT and SIGTERM end the process at once, even
-    # while user_mainloop() runs (which never returns to Python)
-    signal.signal(signal.SIGINT, signal.SIG_DFL)
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
-    words = [prog, *argv[1:]]
-    try:
-        module.setup(**{ARGV_PARAM: words})
-    except HalError as exc:
-        code = getattr(exc, "status", None)
-        if code is None:
-            print(f"{prog}: {exc}", file=sys.stderr)
-            return 1
-        # a failed start-up (negative errno) is status 1, like the
-        # reference's; a program's own main() status is kept
-        return 1 if code < 0 else (code & 255 or 1)
-    cleanup = getattr(module, "cleanup", None)
-    if callable(cleanup):
-        cleanup()
-    instance.release(conn)
-    return 0
-
-
-def main(argv: Optional[Sequence[str]] = None) -> int:
-    """``python -m halcompile.gen_user MODULE_FILE args...``."""
-    args = list(sys.argv[1:] if argv is None else argv)
-    if not args:
-        print("usage: python -m halcompile.gen_user MODULE_FILE [ARGS...]",
-              file=sys.stderr)
-        return 2
-    module_path = args[0]
-    name = os.path.basename(module_path).split(".")[0]
-    return run(module_path, [name, *args[1:]])
-
-
-if __name__ == "__main__":      # pragma: no cover
-    sys.exit(main())
