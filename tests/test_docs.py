@@ -26,7 +26,7 @@ PAGES = ["index", "concepts", "tutorial", "components", "halcmd", "halcompile",
          "running", "machine", "tooltable", "gcode", "drivers",
          "driver-realtime", "driver-sim-io", "driver-cia402", "driver-whb04b",
          "driver-mqtt", "driver-candbc", "driver-mb2hal", "homing",
-         "kinematics", "design", "compat", "benchmarks"]
+         "kinematics", "architecture", "design", "compat", "benchmarks"]
 
 
 @pytest.fixture(scope="module")
@@ -92,7 +92,7 @@ def test_api_page_is_generated_from_the_code(site: str) -> None:
                    "halsdk.component", "halsdk.Component.newpin",
                    "halsdk.cleanup", "halsdk.Pin.setp", "halsdk.Signal.sets",
                    "halsdk.Thread", "halsdk.Function",
-                   "halsdk._core.Component", "halsdk.errors.NotFoundError",
+                   "halsdk.core._core.Component", "halsdk.errors.NotFoundError",
                    "halsdk.types.HalType", "halsdk.testing.TestHal.run",
                    "halsdk.testing.TestHal.set", "halsdk.testing.hal",
                    "halsdk.build.build_component"]:
