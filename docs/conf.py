@@ -15,6 +15,7 @@ import os
 import halsdk
 from halcompile.gen_doc import rst_page
 from halcompile.parser import parse_file
+from halcompile.sources import write_if_changed
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 
@@ -35,15 +36,7 @@ def write_component_pages() -> None:
         comp = parse_file(path)
         page = os.path.join(out, comp.name + ".rst")
         wanted.add(page)
-        text = rst_page(comp)
-        try:
-            with open(page, encoding="utf-8") as f:
-                if f.read() == text:
-                    continue
-        except OSError:
-            pass
-        with open(page, "w", encoding="utf-8") as f:
-            f.write(text)
+        write_if_changed(page, rst_page(comp))
     for page in glob.glob(os.path.join(out, "*.rst")):
         if page not in wanted:
             os.remove(page)

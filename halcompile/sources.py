@@ -43,7 +43,7 @@ class GeneratedSource:
         return bool(self.comp.option("userspace"))
 
 
-def _write(path: str, text: str) -> None:
+def write_if_changed(path: str, text: str) -> None:
     """Write ``text`` unless the file holds it already (keeps builds that
     look at file times incremental)."""
     try:
@@ -78,13 +78,15 @@ def generate_source(comp: Component | str, out_dir: str,
     if comp.option("cython"):
         text, origin = gen_cython.generate(comp)
         path = os.path.join(out_dir, comp.name + ".pyx")
-        _write(path, text)
+        write_if_changed(path, text)
         return GeneratedSource(comp, path, "cython", compile_args,
                                link_args, origin)
     path = os.path.join(out_dir, comp.name + ".c")
-    _write(path, gen_c.generate(comp, c_filename or os.path.abspath(path),
-                                max_personalities))
+    text = gen_c.generate(comp, c_filename or os.path.abspath(path),
+                          max_personalities)
+    write_if_changed(path, text)
     return GeneratedSource(comp, path, "c", compile_args, link_args)
 
 
-__all__ = ["CompError", "GeneratedSource", "generate_source"]
+__all__ = ["CompError", "GeneratedSource", "generate_source",
+           "write_if_changed"]

@@ -5,22 +5,7 @@ raises them; this module is where users and the layers above the public
 one import them from.
 """
 
-from halsdk.core.errors import (
-    CapacityError,
-    ConflictError,
-    ExistsError,
-    HalError,
-    HalTypeError,
-    InstanceError,
-    InvalidError,
-    LoadError,
-    NotFoundError,
-    NotPermittedError,
-    StaleError,
-)
+from halsdk.core import errors as _errors
+from halsdk.core.errors import *  # noqa: F403
 
-__all__ = [
-    "CapacityError", "ConflictError", "ExistsError", "HalError",
-    "HalTypeError", "InstanceError", "InvalidError", "LoadError",
-    "NotFoundError", "NotPermittedError", "StaleError",
-]
+__all__ = _errors.__all__

@@ -52,3 +52,10 @@ class StaleError(HalError):
 class LoadError(HalError):
     """A component module fails to import or to set up (a module that is
     not found at all raises :class:`NotFoundError`)."""
+
+
+__all__ = [
+    "CapacityError", "ConflictError", "ExistsError", "HalError",
+    "HalTypeError", "InstanceError", "InvalidError", "LoadError",
+    "NotFoundError", "NotPermittedError", "StaleError",
+]
