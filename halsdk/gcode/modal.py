@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -52,33 +53,28 @@ def group_codes(block: Block) -> tuple[dict[int, int], dict[int, int]]:
     Raises the block's error for an unknown code or two codes of one modal
     group, pointing at the second one.
     """
-    gs: dict[int, int] = {}
-    for value in block.g:
+    return (_by_group(block, "g", block.g, _G_OF),
+            _by_group(block, "m", block.m, _M_OF))
+
+
+def _by_group(block: Block, letter: str, values: Iterable[float],
+              groups: dict[int, int]) -> dict[int, int]:
+    """Map group -> code (tenths) of the ``letter`` codes ``values``."""
+    found: dict[int, int] = {}
+    word = letter.upper()
+    for value in values:
         code = _key(value)
-        name = code_key("g", value)
-        if code not in _G_OF:
-            raise block.error(f"unknown or unsupported G code G{name[1:]}",
-                              name)
-        group = _G_OF[code]
-        if group in gs:
+        name = code_key(letter, value)
+        if code not in groups:
+            raise block.error(f"unknown or unsupported {word} code "
+                              f"{word}{name[1:]}", name)
+        group = groups[code]
+        if group in found:
             raise block.error(
-                f"two G codes of modal group {group} in one block "
-                f"(G{gs[group] / 10:g} and G{name[1:]})", name)
-        gs[group] = code
-    ms: dict[int, int] = {}
-    for value in block.m:
-        code = _key(value)
-        name = code_key("m", value)
-        if code not in _M_OF:
-            raise block.error(f"unknown or unsupported M code M{name[1:]}",
-                              name)
-        group = _M_OF[code]
-        if group in ms:
-            raise block.error(
-                f"two M codes of modal group {group} in one block "
-                f"(M{ms[group] / 10:g} and M{name[1:]})", name)
-        ms[group] = code
-    return gs, ms
+                f"two {word} codes of modal group {group} in one block "
+                f"({word}{found[group] / 10:g} and {word}{name[1:]})", name)
+        found[group] = code
+    return found
 
 
 @dataclass
