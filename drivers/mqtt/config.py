@@ -8,7 +8,7 @@ import os
 import re
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Optional
+from typing import NoReturn, Optional
 
 from .payload import TYPES
 
@@ -277,7 +277,7 @@ class _Typed(argparse.Action):
 
 
 class _Parser(argparse.ArgumentParser):
-    def error(self, message: str) -> None:  # no usage dump, status 1
+    def error(self, message: str) -> NoReturn:  # no usage dump, status 1
         raise ConfigError(f"{self.prog}: {message}")
 
 
