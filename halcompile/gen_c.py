@@ -411,7 +411,7 @@ def _app_main(w: _Writer, comp: Component, personality: bool,
               "    return value;", "}", "")
     if not singleton and not count_function:
         w.add(f"static int default_count = "
-              f"{int(comp.option('default_count', 1))};",  # type: ignore
+              f"{int(comp.option('default_count', 1))};",
               "static int count = 0;",
               f"RTAPI_MP_INT(count, {c_string('number of ' + name)});",
               "static char *names = \"\";",

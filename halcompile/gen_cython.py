@@ -338,8 +338,8 @@ def _emit_setup(o: _Out, comp: Component, personality: bool,
     name, prefix = comp.name, comp.prefix
     singleton = bool(comp.option("singleton"))
     count_function = bool(comp.option("count_function"))
-    default_count = int(comp.option("default_count", 1))  # type: ignore
-    default_pers = int(comp.option("default_personality", 0))  # type: ignore
+    default_count = int(comp.option("default_count", 1))
+    default_pers = int(comp.option("default_personality", 0))
     # ---- one instance
     o.add("cdef int __export(char *prefix, long extra_arg, int pers) "
           "except -1:",

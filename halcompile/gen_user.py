@@ -54,7 +54,7 @@ def app_main(w, comp) -> None:   # w: gen_c._Writer, comp: Component
     count_function = bool(comp.option("count_function"))
     userinit = bool(comp.option("userinit"))
     cleanup = "extra_cleanup();" if comp.option("extra_cleanup") else ""
-    default_count = int(comp.option("default_count", 1))  # type: ignore
+    default_count = int(comp.option("default_count", 1))
     w.add(f"static char *{ARGV_PARAM}[{MAX_ARGS}];",
           f"RTAPI_MP_ARRAY_STRING({ARGV_PARAM}, {MAX_ARGS}, "
           "\"command line of a userspace component (set by its "
@@ -68,7 +68,7 @@ def app_main(w, comp) -> None:   # w: gen_c._Writer, comp: Component
     if personality:
         w.add(f"static int personality_of(const char *inst, int idx) "
               f"{{ (void)inst; (void)idx; return "
-              f"{int(comp.option('default_personality', 0))}; }}")  # type: ignore
+              f"{int(comp.option('default_personality', 0))}; }}")
 
     def export_call(inst: str, idx: str) -> str:
         if personality:

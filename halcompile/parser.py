@@ -167,7 +167,7 @@ class _Parser:
         triple = self.text.startswith('"""', self.pos)
         quote = '"""' if triple else '"'
         self.pos += len(quote)
-        out = []
+        out: list[str] = []
         while True:
             if self.pos >= len(self.text):
                 raise self.error("unterminated string", start)
@@ -420,7 +420,7 @@ class _Parser:
         elif kind == "name":
             if not isinstance(value, str) or not _IDENT.fullmatch(value):
                 raise self.error(f"option {name} takes a C type name", vpos)
-        comp.options[name] = value      # type: ignore[assignment]
+        comp.options[name] = value
         comp.option_locs[name] = self.loc(npos)
 
     def decl_modparam(self, comp: Component, kw: str, pos: int) -> None:

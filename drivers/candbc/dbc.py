@@ -60,10 +60,13 @@ def load_dbc(path: str, shown: Optional[str] = None) -> Database:
     if all(_EMPTY_LINE.match(line) for line in lines):
         raise ConfigError(f"{shown}: empty DBC file")
     try:
-        return cantools.database.load_string(text + _SENTINEL,
-                                             database_format="dbc")
+        db = cantools.database.load_string(text + _SENTINEL,
+                                           database_format="dbc")
     except Exception as exc:     # cantools raises several kinds
         raise ConfigError(_error_text(exc, path, shown, lines)) from None
+    if not isinstance(db, Database):     # (typed: or a diagnostics one)
+        raise ConfigError(f"{shown}: not a CAN database")
+    return db
 
 
 def _error_text(exc: Exception, path: str, shown: str,

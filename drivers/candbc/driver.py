@@ -91,7 +91,7 @@ class CanDbcDriver(Driver):
 
     # -- component -----------------------------------------------------------
     def setup(self) -> None:
-        comp = self.comp
+        comp = self._require()
         for pin in COUNTERS:
             comp.newpin(pin, "u32", "out")
         for port in self.rx:
@@ -147,7 +147,8 @@ class CanDbcDriver(Driver):
         self.check_timeouts()
 
     def _bump(self, pin: str) -> None:
-        self.comp[pin] = (self.comp[pin] + 1) & 0xFFFFFFFF
+        comp = self._require()
+        comp[pin] = (comp[pin] + 1) & 0xFFFFFFFF
 
     def _log_once(self, key: str, text: str) -> None:
         if key not in self._logged:
@@ -169,14 +170,16 @@ class CanDbcDriver(Driver):
             if len(data) != message.length:
                 raise ValueError(f"{len(data)} data bytes, expected "
                                  f"{message.length}")
-            raw = message.decode(data, decode_choices=False, scaling=False)
+            # decode() of a non-container message, typed as a dict
+            raw = message.decode_simple(data, decode_choices=False,
+                                        scaling=False)
         except Exception as exc:     # never let a frame stop the loop
             self._bump("rx-errors")
             self._log_once(f"rx:{message.name}:{type(exc).__name__}",
                            f"message {message.name}: bad frame: {exc} "
                            "(further ones only counted in rx-errors)")
             return
-        comp = self.comp
+        comp = self._require()
         for signal_name, value in raw.items():
             sp = port.by_signal.get(signal_name)
             if sp is not None:
@@ -187,9 +190,10 @@ class CanDbcDriver(Driver):
 
     def check_timeouts(self) -> None:
         now = self.clock()
+        comp = self._require()
         for port in self.rx:
             if port.timeout > 0 and now - port.last_seen > port.timeout:
-                self.comp[f"{port.name}.timeout"] = True
+                comp[f"{port.name}.timeout"] = True
 
     # -- transmit ------------------------------------------------------------
     def write(self) -> None:
@@ -197,8 +201,9 @@ class CanDbcDriver(Driver):
         if bus is None:
             raise DriverError("bus not open")
         now = self.clock()
+        comp = self._require()
         for port in self.tx:
-            raw = {sp.signal.name: sp.to_raw(self.comp[sp.pin])
+            raw = {sp.signal.name: sp.to_raw(comp[sp.pin])
                    for sp in port.signals}
             due = port.period > 0 and now >= port.next_due
             first = port.last_sent is None
@@ -228,8 +233,11 @@ class CanDbcDriver(Driver):
         frame = can.Message(arbitration_id=message.frame_id,
                             is_extended_id=bool(message.is_extended_frame),
                             is_fd=bool(message.is_fd), data=data)
+        bus = self.bus
+        if bus is None:
+            raise DriverError("bus not open")
         try:
-            self.bus.send(frame)
+            bus.send(frame)
         except (can.CanError, OSError) as exc:
             raise DriverError(f"bus send: {exc}") from None
         port.last_sent = raw

@@ -8,7 +8,7 @@ import math
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Callable, Optional
+from typing import Callable, NoReturn, Optional
 
 import can
 from cantools.database.can import Database, Message
@@ -49,10 +49,10 @@ class Config:
 
 
 class _Parser(argparse.ArgumentParser):
-    def error(self, message: str) -> None:     # one line, status 1
+    def error(self, message: str) -> NoReturn:  # one line, status 1
         raise ConfigError(message)
 
-    def parse_args(self, args=None, namespace=None):  # type: ignore
+    def parse_args(self, args=None, namespace=None):
         """Unknown options first, then the missing ``--dbc``."""
         parsed, extra = self.parse_known_args(args, namespace)
         if extra:

@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 import logging
 import sys
-from typing import Optional
+from typing import NoReturn, Optional
 
 from halsdk.driverkit import IOLoop
 
@@ -21,7 +21,7 @@ class UsageError(Exception):
 
 
 class _Parser(argparse.ArgumentParser):
-    def error(self, message: str) -> None:     # one line, status 1
+    def error(self, message: str) -> NoReturn:  # one line, status 1
         raise UsageError(message)
 
 

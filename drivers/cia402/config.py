@@ -178,8 +178,8 @@ def find_var(od: ObjectDictionary, index: int, sub: int
 def _pdos(r: _Reader, section: str, od: ObjectDictionary, kind: str,
           defaults: dict[int, list[tuple[int, int]]]
           ) -> dict[int, list[PdoEntry]]:
-    given = {n: r.ini.get(section, f"{kind}{n}") for n in range(1, 5)}
-    given = {n: v for n, v in given.items() if v is not None}
+    given = {n: v for n in range(1, 5)
+             if (v := r.ini.get(section, f"{kind}{n}")) is not None}
     source = ({n: [(i, s) for i, s in objs] for n, objs in defaults.items()}
               if not given else None)
     out: dict[int, list[PdoEntry]] = {}

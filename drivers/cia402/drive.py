@@ -12,6 +12,7 @@ from collections import deque
 from typing import Callable, Optional
 
 import canopen
+from canopen.objectdictionary import ODVariable
 from canopen.sdo import SdoAbortedError, SdoClient, SdoCommunicationError
 
 from halsdk.component import Component
@@ -119,12 +120,19 @@ class DriveLink:
         self.sdo = None
         self.link = CONFIGURE
 
+    def _attached(self) -> tuple[canopen.Network, SdoClient]:
+        """The network and SDO client of :meth:`attach`."""
+        if self.network is None or self.sdo is None:
+            raise RuntimeError(f"{self.name}: not attached to a network")
+        return self.network, self.sdo
+
     def known_cob_ids(self) -> set[int]:
         nid = self.cfg.node_id
         return {0x580 + nid, 0x700 + nid, 0x80 + nid, *self._tpdo_by_cob}
 
-    # notifier thread callbacks: store only
-    def _on_heartbeat(self, can_id: int, data: bytes, ts: float) -> None:
+    # notifier thread callbacks (canopen passes a bytearray): store only
+    def _on_heartbeat(self, can_id: int, data: bytes | bytearray,
+                      ts: float) -> None:
         if len(data) != 1:
             self.count_malformed(can_id, f"heartbeat of {len(data)} bytes")
             return
@@ -134,7 +142,8 @@ class DriveLink:
             if data[0] == 0:
                 self._bootup = True
 
-    def _on_emcy(self, can_id: int, data: bytes, ts: float) -> None:
+    def _on_emcy(self, can_id: int, data: bytes | bytearray,
+                 ts: float) -> None:
         if len(data) != 8:
             self.count_malformed(can_id, f"EMCY of {len(data)} bytes")
             return
@@ -142,25 +151,28 @@ class DriveLink:
         with self._lock:
             self._emcy.append((code, reg))
 
-    def _on_tpdo(self, can_id: int, data: bytes, ts: float) -> None:
+    def _on_tpdo(self, can_id: int, data: bytes | bytearray,
+                 ts: float) -> None:
         entries = self._tpdo_by_cob[can_id]
         if 8 * len(data) != sum(e.bits for e in entries):
             self.count_malformed(can_id, f"TPDO of {len(data)} bytes")
             return
-        values = {}
+        values: dict[tuple[int, int], int | float] = {}
         pos = 0
         for e in entries:
             size = e.bits // 8
-            values[(e.index, e.subindex)] = e.var.decode_raw(
-                bytes(data[pos:pos + size]))
+            value = e.var.decode_raw(bytes(data[pos:pos + size]))
+            if isinstance(value, (int, float)):   # read() uses numbers only
+                values[(e.index, e.subindex)] = value
             pos += size
         with self._lock:
             self._values.update(values)
 
     # -- configuration ----------------------------------------------------
     def _write(self, index: int, sub: int, data: bytes, what: str) -> None:
+        sdo = self._attached()[1]
         try:
-            self.sdo.download(index, sub, data)
+            sdo.download(index, sub, data)
         except SdoAbortedError as exc:
             raise SdoConfigError(
                 f"SDO abort writing 0x{index:04X}:{sub:02X} ({what}): "
@@ -173,6 +185,10 @@ class DriveLink:
 
     def _value(self, index: int, value: int | float, what: str) -> None:
         var = self.cfg.od[index]
+        if not isinstance(var, ODVariable):
+            raise SdoConfigError(
+                f"0x{index:04X} ({what}) is not a single object in the EDS "
+                f"{self.cfg.eds}", CODE_CONFIG)
         self._write(index, 0, var.encode_raw(value), what)
 
     def _map(self, comm: int, mapping: int, cob: int,
@@ -193,7 +209,8 @@ class DriveLink:
         """Pre-operational, SDO configuration, PDO mapping, start."""
         cfg = self.cfg
         nid = cfg.node_id
-        self.network.send_message(0, bytes([0x80, nid]))
+        network = self._attached()[0]
+        network.send_message(0, bytes([0x80, nid]))
         if cfg.heartbeat_period > 0:
             self._value(0x1017, int(round(cfg.heartbeat_period * 1000)),
                         "producer heartbeat time")
@@ -219,7 +236,7 @@ class DriveLink:
             self._values.clear()
             self._bootup = False
             self._last_heartbeat = self.clock()   # grace period
-        self.network.send_message(0, bytes([0x01, nid]))
+        network.send_message(0, bytes([0x01, nid]))
 
     # -- faults -------------------------------------------------------------
     def _note(self, text: str, level: int = logging.ERROR) -> None:
@@ -293,10 +310,11 @@ class DriveLink:
             CODE_NO_REPLY, CODE_HEARTBEAT)
         comp[p + "operational"] = running
         comp[p + "heartbeat-lost"] = self.link == LOST
-        sw = values.get((0x6041, 0))
-        if running and sw is not None:
-            state = sm.decode(int(sw))
-            comp[p + "statusword"] = int(sw)
+        sw_value = values.get((0x6041, 0))
+        if running and sw_value is not None:
+            sw = int(sw_value)
+            state = sm.decode(sw)
+            comp[p + "statusword"] = sw
             comp[p + "target-reached"] = bool(sw & sm.SW_TARGET_REACHED)
         else:
             state = sm.NO_DATA
@@ -348,7 +366,7 @@ class DriveLink:
 
     def _read_error_code(self) -> int:
         try:
-            raw = self.sdo.upload(0x603F, 0)
+            raw = self._attached()[1].upload(0x603F, 0)
             return struct.unpack_from("<H", raw)[0]
         except Exception as exc:   # no 0x603F, no reply: code unknown
             log.debug("%s: reading 0x603F: %s", self.name, exc)
@@ -398,7 +416,7 @@ class DriveLink:
         for n, entries in cfg.rpdo.items():
             data = b"".join(e.var.encode_raw(self._clamp(e, values[e.index]))
                             for e in entries)
-            self.network.send_message(cfg.rpdo_cob(n), data)
+            self._attached()[0].send_message(cfg.rpdo_cob(n), data)
 
     @staticmethod
     def _clamp(e: PdoEntry, value: int) -> int:

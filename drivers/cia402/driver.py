@@ -11,7 +11,7 @@ from typing import Optional
 import can
 import canopen
 
-from halsdk.driverkit import Driver
+from halsdk.driverkit import Driver, DriverError
 
 from .config import BusConfig
 from .drive import DriveLink
@@ -73,7 +73,7 @@ class Cia402Driver(Driver):
 
     # -- pins ---------------------------------------------------------------
     def setup(self) -> None:
-        comp = self.comp
+        comp = self._require()
         comp.newpin("unknown-frames", "u32", "out")
         comp.newpin("malformed-frames", "u32", "out")
         for cfg in self.config.drives:
@@ -123,6 +123,10 @@ class Cia402Driver(Driver):
                 exc.strerror else str(exc) or type(exc).__name__
             raise ConnectionError(f"{interface} channel {cfg.channel}: "
                                   f"{reason}") from None
+        if network.notifier is None:      # connect() always starts one
+            network.disconnect()
+            raise ConnectionError(f"{interface} channel {cfg.channel}: "
+                                  "no CAN notifier")
         network.notifier.add_listener(_FrameWatch(self))
         self.network = network
         for link in self.drives:
@@ -152,15 +156,21 @@ class Cia402Driver(Driver):
             self.sim.stop()
             self.sim = None
 
+    def _network(self) -> canopen.Network:
+        if self.network is None:
+            raise DriverError("bus not open")
+        return self.network
+
     def read(self) -> None:
-        self.network.check()
+        self._network().check()
         for link in self.drives:
             link.read()
+        comp = self._require()
         with self._count_lock:
-            self.comp["unknown-frames"] = self._unknown & 0xFFFFFFFF
-            self.comp["malformed-frames"] = self._malformed & 0xFFFFFFFF
+            comp["unknown-frames"] = self._unknown & 0xFFFFFFFF
+            comp["malformed-frames"] = self._malformed & 0xFFFFFFFF
 
     def write(self) -> None:
         for link in self.drives:
             link.write()
-        self.network.send_message(0x80, b"")          # SYNC
+        self._network().send_message(0x80, b"")          # SYNC

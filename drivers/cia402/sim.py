@@ -78,8 +78,12 @@ class SimDrive:
 
     def get(self, index: int, sub: int = 0) -> int | float:
         """The value of an object."""
-        return self._var(index, sub).decode_raw(
+        value = self._var(index, sub).decode_raw(
             self.node.get_data(index, sub))
+        if not isinstance(value, (int, float)):
+            raise TypeError(f"sim node {self.node_id}: object "
+                            f"0x{index:04X}:{sub:02X} is not a number")
+        return value
 
     def set(self, index: int, value: int | float, sub: int = 0) -> None:
         self.node.data_store.setdefault(index, {})[sub] = \
@@ -98,7 +102,7 @@ class SimDrive:
         network.subscribe(0, self._on_nmt)
         network.subscribe(0x80, self._on_sync)
         for n in range(4):
-            self._route_rpdo(n, self.get(0x1400 + n, 1))
+            self._route_rpdo(n, int(self.get(0x1400 + n, 1)))
         self._update_status()
 
     def _send(self, can_id: int, data: bytes) -> None:
@@ -109,14 +113,18 @@ class SimDrive:
                 log.debug("sim node %d: send failed: %s", self.node_id, exc)
 
     def _route_rpdo(self, n: int, cob: int) -> None:
+        network = self.network
+        if network is None:
+            raise RuntimeError(f"sim node {self.node_id}: not attached")
         old = self._rpdo_cobs.pop(n, None)
         if old is not None:
-            self.network.unsubscribe(old, self._on_rpdo)
+            network.unsubscribe(old, self._on_rpdo)
         if not cob & 0x80000000:
             self._rpdo_cobs[n] = cob & 0x7FF
-            self.network.subscribe(cob & 0x7FF, self._on_rpdo)
+            network.subscribe(cob & 0x7FF, self._on_rpdo)
 
-    def _on_sdo(self, can_id: int, data: bytes, timestamp: float) -> None:
+    def _on_sdo(self, can_id: int, data: bytes | bytearray,
+                timestamp: float) -> None:
         if self.online:
             with self._lock:
                 self.node.sdo.on_request(can_id, data, timestamp)
@@ -137,7 +145,8 @@ class SimDrive:
         self._next_heartbeat = now + period
         self._send(0x700 + self.node_id, bytes([self.nmt_state]))
 
-    def _on_nmt(self, can_id: int, data: bytes, timestamp: float) -> None:
+    def _on_nmt(self, can_id: int, data: bytes | bytearray,
+                timestamp: float) -> None:
         if len(data) != 2 or data[1] not in (0, self.node_id) \
                 or not self.online:
             return
@@ -197,14 +206,15 @@ class SimDrive:
 
     # -- PDOs -----------------------------------------------------------
     def _mapping(self, base: int, n: int) -> list[tuple[int, int, int]]:
-        count = self.get(base + n, 0)
+        count = int(self.get(base + n, 0))
         out = []
         for k in range(1, count + 1):
-            entry = self.get(base + n, k)
+            entry = int(self.get(base + n, k))
             out.append((entry >> 16, (entry >> 8) & 0xFF, entry & 0xFF))
         return out
 
-    def _on_rpdo(self, can_id: int, data: bytes, timestamp: float) -> None:
+    def _on_rpdo(self, can_id: int, data: bytes | bytearray,
+                 timestamp: float) -> None:
         if not self.online or self.nmt_state != OPERATIONAL:
             return
         n = next((k for k, c in self._rpdo_cobs.items() if c == can_id),
@@ -224,7 +234,8 @@ class SimDrive:
             if any(index == 0x6040 for index, _, _ in mapping):
                 self._controlword(int(self.get(0x6040)))
 
-    def _on_sync(self, can_id: int, data: bytes, timestamp: float) -> None:
+    def _on_sync(self, can_id: int, data: bytes | bytearray,
+                 timestamp: float) -> None:
         if not self.online or self.nmt_state != OPERATIONAL:
             return
         with self._lock:
@@ -232,7 +243,7 @@ class SimDrive:
             self._step(self.period)
             frames = []
             for n in range(4):
-                cob = self.get(0x1800 + n, 1)
+                cob = int(self.get(0x1800 + n, 1))
                 if cob & 0x80000000:
                     continue
                 payload = b"".join(self.node.get_data(i, s)

@@ -7,7 +7,7 @@ import logging
 import re
 import sys
 from collections.abc import Sequence
-from typing import Optional
+from typing import NoReturn, Optional
 
 from halsdk.errors import HalError
 
@@ -21,7 +21,7 @@ LEVELS = {0: logging.CRITICAL + 1, 1: logging.WARNING, 2: logging.INFO,
 class _Parser(argparse.ArgumentParser):
     """Usage errors give one line and exit status 1, as bad configs do."""
 
-    def error(self, message: str):  # type: ignore[override]
+    def error(self, message: str) -> NoReturn:
         print(f"{self.prog}: {message} (see {self.prog} --help)",
               file=sys.stderr)
         sys.exit(1)

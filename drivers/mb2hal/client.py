@@ -50,6 +50,7 @@ class ModbusLink:
         from pymodbus.client import ModbusSerialClient, ModbusTcpClient
         from pymodbus.framer import FramerType
         link = self.link
+        client: ModbusTcpClient | ModbusSerialClient
         if link.kind == "tcp":
             client = ModbusTcpClient(link.ip, port=link.port, timeout=timeout,
                                      retries=0)
@@ -87,8 +88,14 @@ class ModbusLink:
 
     def execute(self, tx: Transaction,
                 values: Optional[Sequence[int]] = None) -> list[int]:
-        """Run one transaction; return the values read (reads) or []."""
+        """Run one transaction; return the values read (reads) or [].
+        A write needs ``values`` (one per element)."""
         from pymodbus.exceptions import ModbusException
+        if values is None:
+            if tx.is_write:
+                raise TypeError(f"transaction {tx.name}: a write needs "
+                                "values")
+            values = ()
         if self.client is None:
             raise LinkDown(f"{self.link.describe()}: not connected")
         self._timeouts(tx)

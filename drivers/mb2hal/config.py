@@ -9,7 +9,7 @@ import difflib
 import math
 import re
 from dataclasses import dataclass, field
-from typing import Callable, Optional, TypeVar
+from typing import Callable, Optional, TypeVar, overload
 
 from halsdk.ini import IniFile
 
@@ -165,8 +165,18 @@ class _Reader:
             raise self.fail(section, key, f"'{text}' {rule}")
         return value
 
+    @overload
+    def integer(self, section: str, key: str, default: int,
+                low: int = ..., high: int = ...) -> int: ...
+
+    @overload
+    def integer(self, section: str, key: str, default: None = None,
+                low: int = ..., high: int = ...) -> Optional[int]: ...
+
     def integer(self, section: str, key: str, default: Optional[int] = None,
                 low: int = 0, high: int = 2**31 - 1) -> Optional[int]:
+        """The integer value of ``key`` in [low, high]; ``default`` when
+        the key is absent (so never None when ``default`` is an int)."""
         return self.typed(section, key, int, "an integer", default,
                           lambda v: low <= v <= high,
                           f"is out of range {low}..{high}")

@@ -9,7 +9,7 @@ import socket
 import subprocess
 import tempfile
 import time
-from typing import Optional
+from typing import BinaryIO, Optional
 
 MOSQUITTO = "/usr/sbin/mosquitto"
 
@@ -42,6 +42,7 @@ class Mosquitto:
         self.port = port or free_port()
         self.extra = extra
         self.proc: Optional[subprocess.Popen] = None
+        self.log: Optional[BinaryIO] = None     # mosquitto's output
 
     def add_user(self, user: str, password: str) -> str:
         """Add to the broker's password file (hashed with mosquitto_passwd
@@ -101,9 +102,9 @@ class Mosquitto:
             except subprocess.TimeoutExpired:
                 proc.kill()
                 proc.wait(5)
-        if getattr(self, "log", None) is not None:
-            self.log.close()
-            self.log = None
+        log, self.log = self.log, None
+        if log is not None:
+            log.close()
 
     def __enter__(self) -> Mosquitto:
         self.start()

@@ -53,7 +53,9 @@ class Link:
         client = _Client(CallbackAPIVersion.VERSION2,
                          client_id=cfg.client_id,
                          protocol=mqtt.MQTTv311)
-        client.reconnect_delay_set(cfg.backoff, cfg.backoff_max)
+        # paho annotates the delays as int but waits float seconds
+        client.reconnect_delay_set(
+            cfg.backoff, cfg.backoff_max)  # type: ignore[arg-type]
         client.connect_timeout = 3.0
         client.max_queued_messages_set(10000)
         if cfg.user:

@@ -8,7 +8,7 @@ import os
 import re
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Optional
+from typing import NoReturn, Optional
 
 from .payload import TYPES
 
@@ -149,11 +149,11 @@ def _convert(key: str, text: str, where: str, label: str = "",
                 raise ValueError(f"{text!r} is not 'flat' or 'full'")
             return text == "flat"
         if kind in INT_LIMITS:
-            value = int(text)
+            whole = int(text)
             low, high = INT_LIMITS[kind]
-            if not low <= value <= high:
-                raise ValueError(f"{value} is not in {low}..{high}")
-            return value
+            if not low <= whole <= high:
+                raise ValueError(f"{whole} is not in {low}..{high}")
+            return whole
         value = float(text)
         problem = _number_problem(kind, value, publisher, text)
         if problem:
@@ -277,7 +277,7 @@ class _Typed(argparse.Action):
 
 
 class _Parser(argparse.ArgumentParser):
-    def error(self, message: str) -> None:  # no usage dump, status 1
+    def error(self, message: str) -> NoReturn:  # no usage dump, status 1
         raise ConfigError(f"{self.prog}: {message}")
 
 

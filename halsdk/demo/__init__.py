@@ -19,9 +19,12 @@ import sys
 import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Optional, TextIO
+from typing import TYPE_CHECKING, Any, Optional, TextIO
 
 from halsdk.atomicfile import write_atomic
+
+if TYPE_CHECKING:
+    from halsdk.ini import IniFile
 
 __all__ = ["Summary", "machine_folder", "main", "run"]
 
@@ -55,6 +58,15 @@ def machine_folder() -> Path:
         raise FileNotFoundError(f"the demo's machine is missing: no "
                                 f"{folder / 'mill.ini'}")
     return folder
+
+
+def _ini_number(ini: IniFile, section: str, key: str) -> float:
+    """A number that the demo's INI file must give."""
+    text = ini.get(section, key)
+    if text is None:
+        raise ValueError(f"the demo's machine is broken: {ini.path} has no "
+                         f"[{section}]{key}")
+    return float(text)
 
 
 class _Recorder:
@@ -166,8 +178,8 @@ def run(out_png: Optional[str] = "demo.png", realtime: bool = False,
         launcher.start(realtime=realtime)
         hal = launcher.hal
         ini_file = launcher.ini
-        summary.workpiece_top = float(ini_file.get("SIM", "WORKPIECE_TOP"))
-        summary.ferror_limit = [float(ini_file.get(f"JOINT_{n}", "FERROR"))
+        summary.workpiece_top = _ini_number(ini_file, "SIM", "WORKPIECE_TOP")
+        summary.ferror_limit = [_ini_number(ini_file, f"JOINT_{n}", "FERROR")
                                 for n in range(JOINTS)]
         print(f"mill started from {ini} "
               f"({'real time' if realtime else 'stepped, simulated time'})",

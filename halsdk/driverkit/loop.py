@@ -9,6 +9,7 @@ import threading
 import time
 from typing import Callable, Optional
 
+from halsdk.component import Component
 from halsdk.driverkit.backoff import Backoff
 from halsdk.driverkit.base import (
     FAULT_OPEN,
@@ -88,7 +89,7 @@ class IOLoop:
             try:
                 d.open()
             except Exception as exc:
-                self._failed(FAULT_OPEN, exc, now)
+                self._failed(comp, FAULT_OPEN, exc, now)
                 return
             self.connected = True
             comp["connected"] = True
@@ -101,20 +102,21 @@ class IOLoop:
             d.write()
             t2 = self.clock()
         except Exception as exc:
-            self._failed(stage, exc, now)
+            self._failed(comp, stage, exc, now)
             return
         comp["read-time"] = t1 - t0
         comp["write-time"] = t2 - t1
         self.retry.succeeded()
         d.clear_fault()
 
-    def _failed(self, code: int, exc: BaseException, now: float) -> None:
+    def _failed(self, comp: Component, code: int, exc: BaseException,
+                now: float) -> None:
         d = self.driver
         d.set_fault(code, exc)
         if self.connected:
             d.safe_close()
             self.connected = False
-            d.comp["connected"] = False
+            comp["connected"] = False
         wait = self.retry.failed(now)
         log.info("%s: reconnect in %.3g s", d.prefix, wait)
 

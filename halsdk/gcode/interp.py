@@ -37,7 +37,7 @@ from .modal import AXIS_USERS_GROUP0, ModalState, group_codes
 
 AXES = "xyzabcuvw"
 ROTARY = (3, 4, 5)
-ZERO9: C.Pose = (0.0,) * 9  # type: ignore[assignment]
+ZERO9: C.Pose = (0.0,) * 9
 #: plane -> (first axis, second axis, normal axis, first/second centre words)
 PLANES = {170: (0, 1, 2, "ij"), 180: (2, 0, 1, "ki"), 190: (1, 2, 0, "jk")}
 COORD_CODES = (540, 550, 560, 570, 580, 590, 591, 592, 593)
@@ -262,7 +262,7 @@ class Interpreter:
         axes = self._axis_words(block)
         g0 = gs.get(0)
         user0 = g0 in AXIS_USERS_GROUP0
-        if user0 and gs.get(1, 800) != 800 and axes:
+        if g0 in AXIS_USERS_GROUP0 and gs.get(1, 800) != 800 and axes:
             raise block.error(
                 f"G{g0 / 10:g} and G{gs[1] / 10:g} both use the axis words",
                 code_key("g", gs[1] / 10))
@@ -520,8 +520,8 @@ class Interpreter:
             if "q" not in block.words:
                 raise block.error(f"M{code // 10} needs a Q word",
                                   code_key("m", code / 10))
-            cls = C.SyncAout if code == 670 else C.AoutNow
-            self._emit(cls(index, block.words["q"], line))
+            acls = C.SyncAout if code == 670 else C.AoutNow
+            self._emit(acls(index, block.words["q"], line))
 
     def _stop(self, code: int, line: int) -> None:
         if code == 0:
@@ -750,7 +750,7 @@ class Interpreter:
             c1 = m1 - sign * h * (e2 - s2) / chord
             c2 = m2 + sign * h * (e1 - s1) / chord
         else:
-            w1, w2 = centre_words
+            w1, w2 = centre_words[0], centre_words[1]
             if w1 not in block.words and w2 not in block.words:
                 raise block.error(f"{w1.upper()} and {w2.upper()} words both "
                                   "missing for a centre-format arc", key)

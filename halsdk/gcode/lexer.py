@@ -53,7 +53,7 @@ class OWord:
     """``o<name> keyword [args]``; ``name`` is a string (``'100'`` or a
     lower-case name) or an expression for ``o[#1] call``."""
 
-    name: object
+    name: str | Expr
     keyword: str
     args: list[Expr]
     column: int
@@ -392,7 +392,7 @@ def _parameter(reader: _Reader) -> ParamRef:
 def _oword(reader: _Reader) -> OWord:
     column = reader.column()
     reader.take()
-    name: object
+    name: str | Expr
     if reader.peek() == "<":
         name = _name(reader)
     elif reader.peek() == "[" or reader.peek() == "#":

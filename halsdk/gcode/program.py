@@ -59,6 +59,14 @@ class _Unit:
         line = self.lines[index]
         return line.oword if isinstance(line, Line) else None
 
+    def keyword(self, index: int) -> str:
+        """The keyword of line ``index``, which the scan found an o-word."""
+        oword = self.oword(index)
+        if oword is None:
+            raise RuntimeError(f"{self.file}: line {index + 1} is not an "
+                               "o-word")
+        return oword.keyword
+
 
 def _name_text(oword: OWord) -> str:
     return oword.name if isinstance(oword.name, str) else "?"
@@ -120,7 +128,7 @@ def _scan(unit: _Unit) -> _Structure:
                 raise fail(index, f"{label} {keyword} without {label} if")
             opener = stack[-1][2]
             branches = result.branches[opener]
-            if branches and unit.oword(branches[-1]).keyword == "else" \
+            if branches and unit.keyword(branches[-1]) == "else" \
                     and keyword != "endif":
                 raise fail(index, f"{label} {keyword} after {label} else")
             branches.append(index)
@@ -280,8 +288,8 @@ class Program:
         values = [(self._parameter_key(a.target, line),
                    self._value(a.value, line), a.column)
                   for a in line.assignments]
-        for key, value, column in values:
-            self._set(key, value, line, column)
+        for param, value, column in values:
+            self._set(param, value, line, column)
         for comment in line.comments:
             if comment.kind == "msg":
                 block.message = comment.text
@@ -449,7 +457,7 @@ class Program:
                 index = structure.loop_end[opener] + 1
             elif keyword == "continue":
                 opener = structure.loop_of[index]
-                index = opener if unit.oword(opener).keyword == "while" \
+                index = opener if unit.keyword(opener) == "while" \
                     else structure.loop_end[opener]
             else:  # pragma: no cover - the lexer admits no other keyword
                 raise GCodeError(f"unsupported o-word {keyword}", line.file,

@@ -66,9 +66,9 @@ class Executor(C.Canon):
         self.speed = 0.0
         self.spindle_dir = 0
         self.g5x_index = 1
-        self.g5x_offset = (0.0,) * 9
-        self.g92_offset = (0.0,) * 9
-        self.tool_offset = (0.0,) * 9
+        self.g5x_offset: tuple[float, ...] = (0.0,) * 9
+        self.g92_offset: tuple[float, ...] = (0.0,) * 9
+        self.tool_offset: tuple[float, ...] = (0.0,) * 9
         self.ended = False
         self.probes = 0
         #: commands emitted by the interpreter and not yet carried out

@@ -440,15 +440,16 @@ class ToolTable:
         pocket = self._require(tool)
         if orientation is not None and not 0 <= orientation <= 9:
             raise ToolTableError(f"orientation {orientation} is not in 0..9")
-        changes: dict[str, object] = {}
-        for name, value in (("offset", offset), ("diameter", diameter),
-                            ("frontangle", frontangle),
-                            ("backangle", backangle),
-                            ("orientation", orientation),
-                            ("comment", comment)):
-            if value is not None:
-                changes[name] = tuple(value) if name == "offset" else value
-        entry = dataclasses.replace(self.entry(pocket), **changes)
+        old = self.entry(pocket)
+        entry = dataclasses.replace(
+            old,
+            offset=old.offset if offset is None else tuple(offset),
+            diameter=old.diameter if diameter is None else diameter,
+            frontangle=old.frontangle if frontangle is None else frontangle,
+            backangle=old.backangle if backangle is None else backangle,
+            orientation=(old.orientation if orientation is None
+                         else orientation),
+            comment=old.comment if comment is None else comment)
         self.set_entry(pocket, entry)
         if not self.random and self.current_pocket == pocket:
             self._spindle = entry
