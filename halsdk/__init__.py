@@ -25,9 +25,10 @@ from halsdk.errors import (
                            LoadError,
                            NotFoundError,
                            NotPermittedError,
+                           Rule,
                            StaleError,
 )
-from halsdk.hal import Hal
+from halsdk.hal import Hal, check_name
 from halsdk.instance import cleanup
 from halsdk.types import Direction, HalType
 
@@ -36,6 +37,8 @@ Param = _core.Param
 Signal = _core.Signal
 Function = _core.Function
 Thread = _core.Thread
+Instance = _core.Instance
+Stream = _core.Stream
 
 BIT, FLOAT, S32, U32, S64, U64 = (HalType.BIT, HalType.FLOAT, HalType.S32,
                                   HalType.U32, HalType.S64, HalType.U64)
@@ -48,7 +51,8 @@ __version__ = "0.1.0"
 
 __all__ = [
     "Hal", "component", "Component", "cleanup", "HalType", "Direction",
-    "Pin", "Param", "Signal", "Function", "Thread",
+    "Pin", "Param", "Signal", "Function", "Thread", "Instance", "Stream",
+    "check_name", "Rule",
     "BIT", "FLOAT", "S32", "U32", "S64", "U64", "IN", "OUT", "IO", "RO",
     "RW", "NAME_LEN", "REFERENCE_NAME_LEN",
     "HalError", "NotFoundError", "ExistsError", "HalTypeError",
