@@ -14,7 +14,7 @@ own words: halcmd maps them to the reference's messages.
 from __future__ import annotations
 
 from enum import Enum
-from typing import Optional
+from typing import Callable, Optional
 
 
 class Rule(str, Enum):
@@ -113,7 +113,7 @@ class LoadError(HalError):
 
 
 #: errno of a failed core call -> the exception class it raises
-ERRNO_CLASS: dict[int, type[HalError]] = {
+ERRNO_CLASS: dict[int, Callable[..., HalError]] = {
     2: NotFoundError,           # ENOENT
     17: ExistsError,            # EEXIST
     91: HalTypeError,           # EPROTOTYPE
