@@ -9,13 +9,13 @@ from __future__ import annotations
 
 from typing import Optional
 
-from halsdk.core import _core
+from halsdk.types import HalType
 
 MAX_ELEMENTS = 256
 
 # cfg letters: the reference's f b s u, and l k for the 64-bit types
-LETTERS = {"f": _core.FLOAT, "b": _core.BIT, "s": _core.S32, "u": _core.U32,
-           "l": _core.S64, "k": _core.U64}
+LETTERS = {"f": HalType.FLOAT, "b": HalType.BIT, "s": HalType.S32,
+           "u": HalType.U32, "l": HalType.S64, "k": HalType.U64}
 
 MODPARAMS = {
     "depth": ([int], None, "FIFO depth (records) of each channel"),

@@ -17,8 +17,8 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Optional, Union
 
-from halsdk.core import _core
-from halsdk.errors import HalError, InvalidError
+from halsdk import NAME_LEN, check_name
+from halsdk.errors import HalError, InvalidError, error_for_errno
 
 # The modparams entries a count/names component declares.
 COUNT_NAMES_MODPARAMS = {
@@ -58,10 +58,10 @@ def instance_names(comp: str, count: int = 0,
             if not name:
                 raise InvalidError(f"names[{index}] is invalid (empty "
                                    "string)")
-            if len(name) > _core.NAME_LEN:
+            if len(name) > NAME_LEN:
                 raise InvalidError(
-                    f'names: "{name[:_core.NAME_LEN]}" too long')
-            _core.check_name(name, "instance")
+                    f'names: "{name[:NAME_LEN]}" too long')
+            check_name(name, "instance")
         return given
     if count == 0:
         count = default_count
@@ -74,5 +74,4 @@ def instance_names(comp: str, count: int = 0,
 def hal_error(code: int, message: str) -> HalError:
     """The exception for a failed HAL API call that returned ``code`` (a
     negative errno); ``message`` is the core's last error message."""
-    cls = getattr(_core, "_ERRNO_CLASS", {}).get(-code, HalError)
-    return cls(message)
+    return error_for_errno(code, message)

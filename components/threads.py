@@ -8,7 +8,7 @@ it can be loaded again to make more.
 
 from __future__ import annotations
 
-from halsdk.core import _core
+from halsdk import Component, Hal
 from halsdk.errors import InvalidError
 
 modparams = {}
@@ -17,11 +17,11 @@ for _n in (1, 2, 3):
     modparams[f"period{_n}"] = (int, 0, f"period of thread {_n} in ns")
     modparams[f"fp{_n}"] = (int, 1, f"thread {_n} runs floating-point code")
 
-_comp_id = -1
+_comp: Component | None = None
 
 
 def setup(**params: object) -> None:
-    global _comp_id
+    global _comp
     wanted = []
     for n in (1, 2, 3):
         name = params.get(f"name{n}", "")
@@ -40,22 +40,27 @@ def setup(**params: object) -> None:
         wanted.append((name, period, bool(params.get(f"fp{n}", 1))))
     if not wanted:
         raise InvalidError("threads: no thread given (name1=... period1=...)")
-    _comp_id = _core.comp_new("threads", _core.COMP_RT)
+    hal = Hal.current()
+    if hal is None:
+        raise InvalidError("threads: no HAL instance in this process")
+    comp = hal.new_component("threads", realtime=True)
     made = []
     try:
         for name, period, fp in wanted:
-            _core.thread_new(name, period, fp, 16)
+            hal.newthread(name, period, fp, 16)
             made.append(name)
     except Exception:
         for name in made:       # nothing half-made
-            _core.thread_delete(name)
+            hal.delthread(name)
+        comp.exit()
         raise
-    _core.comp_ready(_comp_id)
+    comp.ready()
+    _comp = comp
 
 
 def cleanup() -> None:
     """Remove the component; its threads stay."""
-    global _comp_id
-    if _comp_id >= 0 and _core.comp_by_id(_comp_id) is not None:
-        _core.comp_exit(_comp_id)
-    _comp_id = -1
+    global _comp
+    if _comp is not None:
+        _comp.exit()
+    _comp = None

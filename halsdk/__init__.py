@@ -22,19 +22,20 @@ from halsdk.component import Component, component
 from halsdk.core import _core  # noqa: E402
 from halsdk.core.instance import cleanup
 from halsdk.errors import (
-    CapacityError,
-    ConflictError,
-    ExistsError,
-    HalError,
-    HalTypeError,
-    InstanceError,
-    InvalidError,
-    LoadError,
-    NotFoundError,
-    NotPermittedError,
-    StaleError,
+                           CapacityError,
+                           ConflictError,
+                           ExistsError,
+                           HalError,
+                           HalTypeError,
+                           InstanceError,
+                           InvalidError,
+                           LoadError,
+                           NotFoundError,
+                           NotPermittedError,
+                           Rule,
+                           StaleError,
 )
-from halsdk.hal import Hal
+from halsdk.hal import Hal, check_name
 from halsdk.types import Direction, HalType
 
 Pin = _core.Pin
@@ -42,6 +43,8 @@ Param = _core.Param
 Signal = _core.Signal
 Function = _core.Function
 Thread = _core.Thread
+Instance = _core.Instance
+Stream = _core.Stream
 
 BIT, FLOAT, S32, U32, S64, U64 = (HalType.BIT, HalType.FLOAT, HalType.S32,
                                   HalType.U32, HalType.S64, HalType.U64)
@@ -54,7 +57,8 @@ __version__ = "0.1.0"
 
 __all__ = [
     "Hal", "component", "Component", "cleanup", "HalType", "Direction",
-    "Pin", "Param", "Signal", "Function", "Thread",
+    "Pin", "Param", "Signal", "Function", "Thread", "Instance", "Stream",
+    "check_name", "Rule",
     "BIT", "FLOAT", "S32", "U32", "S64", "U64", "IN", "OUT", "IO", "RO",
     "RW", "NAME_LEN", "REFERENCE_NAME_LEN",
     "HalError", "NotFoundError", "ExistsError", "HalTypeError",

@@ -16,15 +16,23 @@ class Component:
     outputs with ``comp["name"]`` (names are relative to the component's
     prefix).  The component and its pins disappear with :meth:`exit`, when
     the process exits, or when the host unloads it.
+
+    ``realtime=True`` makes a realtime component instead: what a module
+    loaded with ``loadrt`` in the host makes (e.g. ``threads``).
     """
 
     def __init__(self, name: str, prefix: Optional[str] = None,
-                 instance_name: Optional[str] = None):
-        self._conn = instance.connect(instance_name)
+                 instance_name: Optional[str] = None, *,
+                 realtime: bool = False, keep_open: bool = True):
+        # keep_open=False: made by Hal.new_component, on the instance
+        # this process uses, without keeping it open
+        self._conn = instance.connect(instance_name) if keep_open else None
         try:
-            self.id = _core.comp_new(name, _core.COMP_USER)
+            self.id = _core.comp_new(
+                name, _core.COMP_RT if realtime else _core.COMP_USER)
         except Exception:
-            instance.release(self._conn)
+            if self._conn is not None:
+                instance.release(self._conn)
             raise
         self.name = name
         self.prefix = prefix if prefix is not None else name
@@ -108,7 +116,8 @@ class Component:
             if _core.attached() and _core.comp_by_id(self.id) is not None:
                 _core.comp_exit(self.id)
         finally:
-            instance.release(self._conn)
+            if self._conn is not None:
+                instance.release(self._conn)
 
     def __enter__(self) -> Component:
         return self

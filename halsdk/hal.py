@@ -9,16 +9,17 @@ import time
 from collections.abc import Iterable
 from typing import Any, Callable, Optional, Union
 
+from halsdk.component import Component
 from halsdk.core import _core, channel, instance
 from halsdk.errors import (
     ConflictError,
-    HalTypeError,
     InvalidError,
     NotFoundError,
     NotPermittedError,
+    Rule,
 )
 from halsdk.loader import Registry
-from halsdk.types import Direction, HalType, parse_type
+from halsdk.types import Direction, HalType, parse_type, type_word
 
 Value = Union[bool, int, float, str]
 
@@ -54,12 +55,29 @@ class Hal:
         self._closed = False
         conn = self._conn
         with conn.lock:
-            if conn.host and not hasattr(conn, "registry"):
+            if conn.host and conn.registry is None:
                 conn.registry = Registry()
                 conn.closers.append(conn.registry.unload_all)
                 for op in _HOST_OPS:
                     conn.handlers[op] = getattr(self, "_host_" + op)
                 conn.handlers["ping"] = lambda: os.getpid()
+
+    @classmethod
+    def current(cls) -> Optional[Hal]:
+        """The instance this process already uses, or None.
+
+        The result is a view that does not count as one more user of the
+        instance: closing it does nothing, and it does not keep the
+        instance open (for modules such as the compat ``hal`` that act on
+        whatever instance their caller opened).
+        """
+        conn = instance.current()
+        if conn is None or not _core.attached():
+            return None
+        view = cls.__new__(cls)
+        view._conn = conn
+        view._closed = True
+        return view
 
     # ------------------------------------------------------------ lifetime
 
@@ -362,48 +380,11 @@ class Hal:
         """Link pins to a signal, creating it with the first pin's type.
 
         Arrow words (``=>``, ``<=``, ``<=>``) are accepted and ignored.
-        All checks are made before anything changes.
+        The core checks every pin before anything changes.
         """
         pins = tuple(p for p in pins if p not in ("=>", "<=", "<=>"))
-        if not pins:
-            raise InvalidError(f"net '{signal}': no pins given")
-        handles = []
-        for name in pins:
-            pin = _core.find("pin", name)
-            if pin is None:
-                raise NotFoundError(f"pin '{name}' not found")
-            handles.append(pin)
-        if _core.find("pin", signal) is not None:
-            raise InvalidError(f"Signal name '{signal}' must not be the same "
-                               "as a pin.  Did you omit the signal name?")
-        sig = _core.find("signal", signal)
-        stype = sig.type if sig is not None else handles[0].type
-        writers = sig.writers if sig is not None else 0
-        bidirs = sig.bidirs if sig is not None else 0
-        for pin in handles:
-            if pin.type != stype:
-                raise HalTypeError(
-                    f"Signal '{signal}' of type "
-                    f"'{_core.TYPE_NAMES[stype]}' cannot add pin "
-                    f"'{pin.name}' of type '{_core.TYPE_NAMES[pin.type]}'")
-            linked = pin.signal
-            if linked is not None and linked.name != signal:
-                raise ConflictError(f"Pin '{pin.name}' was already linked "
-                                    f"to signal '{linked.name}'")
-            if linked is None:
-                writers += pin.direction == _core.OUT
-                bidirs += pin.direction == _core.IO
-        if writers > 1:
-            raise ConflictError(f"net '{signal}': more than one output pin "
-                                "would drive the signal")
-        if writers and bidirs:
-            raise ConflictError(f"net '{signal}': an output pin and I/O "
-                                "pins cannot share a signal")
-        if sig is None:
-            sig = _core.signal_new(signal, stype)
-        for pin in handles:
-            _core.link(pin.name, signal)
-        return sig
+        _core.net(signal, pins)
+        return self._need("signal", signal)
 
     def linkps(self, pin: str, signal: str) -> None:
         _core.link(pin, signal)
@@ -414,33 +395,50 @@ class Hal:
     def unlinkp(self, pin: str) -> None:
         _core.unlink(pin)
 
-    def sets(self, name: str, value: Value) -> None:
-        """Set a signal that has no writer."""
-        self._need("signal", name).sets(value)
+    def sets(self, name: str, value: Value, *, ignore_lock: bool = False,
+             wrap: bool = False) -> None:
+        """Set a signal that has no writer.
+
+        A string is read as halcmd reads it (:mod:`halsdk.values`).
+        ``ignore_lock``: set it even when the instance is locked against
+        setting values (halcmd's ``sets`` does, as the reference's).
+        ``wrap``: an integer word out of range wraps as in C (halcmd).
+        """
+        self._need("signal", name).sets(value, ignore_lock=ignore_lock,
+                                        wrap=wrap)
 
     def gets(self, name: str) -> Value:
         return self._need("signal", name).value
 
     def stype(self, name: str) -> str:
-        return _core.TYPE_NAMES[self._need("signal", name).type]
+        return type_word(self._need("signal", name).type)
 
     # ------------------------------------------------------------ values
 
     def _item(self, name: str):
         item = _core.find("param", name) or _core.find("pin", name)
         if item is None:
-            raise NotFoundError(f"pin or param '{name}' not found")
+            raise NotFoundError(f"pin or param '{name}' not found",
+                                rule=Rule.NOT_FOUND, kind="pin",
+                                names=(name,))
         return item
 
-    def setp(self, name: str, value: Value) -> None:
-        """Set a param, or an unlinked in/io pin, as ``halcmd setp``."""
-        self._item(name).setp(value)
+    def setp(self, name: str, value: Value, *, ignore_lock: bool = False,
+             wrap: bool = False) -> None:
+        """Set a param, or an unlinked in/io pin, as ``halcmd setp``.
+
+        A string is read as halcmd reads it (:mod:`halsdk.values`).
+        ``ignore_lock``: set it even when the instance is locked against
+        setting values (halcmd's ``setp`` does, as the reference's).
+        ``wrap``: an integer word out of range wraps as in C (halcmd).
+        """
+        self._item(name).setp(value, ignore_lock=ignore_lock, wrap=wrap)
 
     def getp(self, name: str) -> Value:
         return self._item(name).value
 
     def ptype(self, name: str) -> str:
-        return _core.TYPE_NAMES[self._item(name).type]
+        return type_word(self._item(name).type)
 
     def alias(self, kind: str, name: str, alias: str) -> None:
         """Give a pin or param (kind ``"pin"``/``"param"``) a new name."""
@@ -462,13 +460,81 @@ class Hal:
     def unlock(self) -> None:
         _core.set_lock(0)
 
+    #: lock bits, as the reference numbers them
+    LOCK_LOAD, LOCK_CONFIG, LOCK_PARAMS, LOCK_RUN, LOCK_ALL = 1, 2, 4, 8, 255
+
+    @property
+    def lock_level(self) -> int:
+        """The lock bits in force (see :meth:`lock`); settable."""
+        return _core.get_lock()
+
+    @lock_level.setter
+    def lock_level(self, level: int) -> None:
+        _core.set_lock(level)
+
+    @property
+    def msg_level(self) -> int:
+        """The message level (0 none .. 5 all, as ``halcmd debug``);
+        settable."""
+        return _core.info()["msg_level"]
+
+    @msg_level.setter
+    def msg_level(self, level: int) -> None:
+        _core.set_msg_level(level)
+
+    def counts(self) -> dict[str, int]:
+        """Number of objects of each kind ("pin": 12, ...)."""
+        return dict(_core.info()["counts"])
+
     # ------------------------------------------------------------ lookup
 
     def _need(self, kind: str, name: str):
         item = _core.find(kind, name)
         if item is None:
-            raise NotFoundError(f"{kind} '{name}' not found")
+            raise NotFoundError(f"{kind} '{name}' not found",
+                                rule=Rule.NOT_FOUND, kind=kind,
+                                names=(name,))
         return item
+
+    KINDS = ("component", "instance", "pin", "param", "signal", "function",
+             "thread", "stream")
+
+    def find(self, kind: str, name: str) -> Optional[Any]:
+        """The handle of the object of a kind ("pin", "signal", ...) of
+        that name (pins and params also by their name before an alias),
+        or None."""
+        self._check_kind(kind)
+        return _core.find(kind, name)
+
+    def items(self, kind: str) -> list:
+        """Handles of every object of a kind, in creation order."""
+        self._check_kind(kind)
+        return _core.items(kind)
+
+    def _check_kind(self, kind: str) -> None:
+        if kind not in self.KINDS:
+            raise InvalidError(f"unknown kind {kind!r} (one of "
+                               f"{', '.join(self.KINDS)})")
+
+    def new_component(self, name: str, prefix: Optional[str] = None, *,
+                      realtime: bool = False) -> Component:
+        """A component of this process on this instance (pins and params
+        as with :func:`halsdk.component`), which does not keep the
+        instance open: halcmd's ``halcmd<pid>``, or with ``realtime`` the
+        component of a module that makes no pins (``threads``)."""
+        if realtime and not self._conn.host:
+            raise NotPermittedError(f"component '{name}': realtime "
+                                    "components live in the host process")
+        return Component(name, prefix, realtime=realtime, keep_open=False)
+
+    def component_by_id(self, comp_id: int) -> Optional[_core.Component]:
+        """The component (or None) with that id."""
+        return _core.comp_by_id(comp_id)
+
+    def shared_block(self, name: str) -> tuple[int, int]:
+        """``(address, size)`` in this process of a named shared block
+        that a realtime module made (NotFoundError if there is none)."""
+        return _core.shmem_attach(name)
 
     def pin(self, name: str) -> _core.Pin:
         return self._need("pin", name)
@@ -641,6 +707,12 @@ class Hal:
             from halsdk.errors import InstanceError
             raise InstanceError(f"HAL instance is inconsistent ({bad} "
                                 f"problems): {report}")
+
+
+def check_name(name: str, what: str = "object") -> None:
+    """Raise :class:`~halsdk.InvalidError` (rule ``BAD_NAME``) if the core
+    would refuse ``name`` for a new ``what`` ("pin", "instance", ...)."""
+    _core.check_name(name, what)
 
 
 class _InstParams:

@@ -27,7 +27,7 @@ import numpy as np
 import pytest
 
 import halsdk
-from halsdk.core import _core
+from halsdk.types import HalType
 
 _counter = itertools.count()
 _created: list[str] = []
@@ -41,8 +41,8 @@ class Trace(dict):
     time: np.ndarray
 
 
-_DTYPES = {_core.BIT: np.bool_, _core.FLOAT: np.float64, _core.S32: np.int32,
-           _core.U32: np.uint32, _core.S64: np.int64, _core.U64: np.uint64}
+_DTYPES = {HalType.BIT: np.bool_, HalType.FLOAT: np.float64, HalType.S32: np.int32,
+           HalType.U32: np.uint32, HalType.S64: np.int64, HalType.U64: np.uint64}
 
 
 class TestHal(halsdk.Hal):
@@ -55,15 +55,15 @@ class TestHal(halsdk.Hal):
         without a writer (sets)."""
         for name, value in values.items():
             item = self._lookup(name)
-            if isinstance(item, _core.Signal):
+            if isinstance(item, halsdk.Signal):
                 item.sets(value)
             else:
                 item.setp(value)
 
     def _lookup(self, name: str):
         """The pin or param of that name, else the signal."""
-        item = (_core.find("pin", name) or _core.find("param", name)
-                or _core.find("signal", name))
+        item = (self.find("pin", name) or self.find("param", name)
+                or self.find("signal", name))
         if item is None:
             raise halsdk.NotFoundError(f"no pin, param or signal '{name}'")
         return item
@@ -88,7 +88,7 @@ class TestHal(halsdk.Hal):
                 raise halsdk.InvalidError(
                     f"input '{name}' has {len(value)} values for {cycles} "
                     "cycles")
-            setter = target.sets if isinstance(target, _core.Signal) \
+            setter = target.sets if isinstance(target, halsdk.Signal) \
                 else target.setp
             plan.append((setter, value))
         out = {n: np.empty(cycles, dtype=_DTYPES[src.type])
@@ -99,7 +99,7 @@ class TestHal(halsdk.Hal):
                 v = value[k]
                 setter(v.item() if isinstance(v, np.generic) else v)
             self.step(1, thread)
-            times[k] = _core.get_time()
+            times[k] = self.time
             for n, src in sources:
                 out[n][k] = src.value
         trace = Trace(out)

@@ -1,4 +1,11 @@
-"""HAL types and directions, with the reference's numeric values."""
+"""HAL types and directions, with the reference's numeric values.
+
+This module is the one table of type and direction words: the names a
+program writes (``"float"``, ``"in"``), the words halcmd shows (``show``
+prints ``float`` and ``s32``, ``setp`` errors say ``S32``), and the
+directions as ``show`` prints them (``IN``, ``OUT``, ``I/O``, ``RO``,
+``RW``).  Every front end takes its words from here.
+"""
 
 from __future__ import annotations
 
@@ -22,6 +29,26 @@ class HalType(IntEnum):
     def __str__(self) -> str:
         return self.name.lower()
 
+    @property
+    def word(self) -> str:
+        """The type as programs and ``show`` write it: ``"s32"``."""
+        return TYPE_WORDS[self]
+
+    @property
+    def value_word(self) -> str:
+        """The type as the reference's value errors write it: ``"S32"``
+        (``bit`` and ``float`` stay lower case)."""
+        return VALUE_WORDS[self]
+
+    @property
+    def is_integer(self) -> bool:
+        return self not in (HalType.BIT, HalType.FLOAT)
+
+    @property
+    def range(self) -> tuple[int, int]:
+        """(least, most) value of an integer type."""
+        return INT_RANGES[self]
+
 
 class Direction(IntEnum):
     """Direction of a pin (IN, OUT, IO) or a param (RO, RW)."""
@@ -32,19 +59,55 @@ class Direction(IntEnum):
     RO = _core.RO
     RW = _core.RW
 
+    @property
+    def word(self) -> str:
+        """The direction as ``show`` prints it: ``"IN"``, ``"I/O"``."""
+        return DIR_WORDS[self]
 
-_TYPE_WORDS = {t.name.lower(): t for t in HalType}
-_DIR_WORDS = {"in": Direction.IN, "out": Direction.OUT, "io": Direction.IO,
-              "i/o": Direction.IO, "ro": Direction.RO, "rw": Direction.RW}
+
+#: type -> the word programs write and ``show`` prints (the core's words)
+TYPE_WORDS = {HalType(t): w for t, w in _core.TYPE_NAMES.items()}
+#: type -> the word of the reference's "value invalid for ..." errors
+VALUE_WORDS = {HalType.BIT: "bit", HalType.FLOAT: "float",
+               HalType.S32: "S32", HalType.U32: "U32", HalType.S64: "S64",
+               HalType.U64: "U64"}
+#: direction -> the word ``show`` prints (the core's words)
+DIR_WORDS = {Direction(d): w for d, w in _core.DIR_NAMES.items()}
+#: integer type -> (least, most)
+INT_RANGES = {HalType.S32: (-(1 << 31), (1 << 31) - 1),
+              HalType.U32: (0, (1 << 32) - 1),
+              HalType.S64: (-(1 << 63), (1 << 63) - 1),
+              HalType.U64: (0, (1 << 64) - 1)}
+
+_TYPE_BY_WORD = {w: t for t, w in TYPE_WORDS.items()}
+_DIR_BY_WORD = {"in": Direction.IN, "out": Direction.OUT,
+                "io": Direction.IO, "i/o": Direction.IO,
+                "ro": Direction.RO, "rw": Direction.RW}
+
+
+def type_word(value: int, unknown: str = "???") -> str:
+    """The word of a type number (``unknown`` for a number that is none)."""
+    try:
+        return TYPE_WORDS[HalType(value)]
+    except ValueError:
+        return unknown
+
+
+def dir_word(value: int, unknown: str = "???") -> str:
+    """The ``show`` word of a direction number."""
+    try:
+        return DIR_WORDS[Direction(value)]
+    except ValueError:
+        return unknown
 
 
 def parse_type(value: Union[str, int]) -> HalType:
-    """A HalType from a word ("float") or a number."""
+    """A HalType from a word ("float", any case) or a number."""
     if isinstance(value, str):
-        t = _TYPE_WORDS.get(value.strip().lower())
+        t = _TYPE_BY_WORD.get(value.strip().lower())
         if t is None:
             raise InvalidError(f"unknown HAL type '{value}' (one of "
-                               f"{', '.join(_TYPE_WORDS)})")
+                               f"{', '.join(_TYPE_BY_WORD)})")
         return t
     try:
         return HalType(value)
@@ -55,7 +118,7 @@ def parse_type(value: Union[str, int]) -> HalType:
 def parse_direction(value: Union[str, int], param: bool = False) -> Direction:
     """A Direction from a word ("in", "rw") or a number."""
     if isinstance(value, str):
-        d = _DIR_WORDS.get(value.strip().lower())
+        d = _DIR_BY_WORD.get(value.strip().lower())
     else:
         try:
             d = Direction(value)

@@ -186,3 +186,8 @@ def test_c_example_builds_and_works(hal, tmp_path, monkeypatch) -> None:
     assert err.value.status == -22
     assert hal.components("wsum") == []
 
+
+
+def test_rules_example_runs(hal) -> None:
+    exec(compile(code_block("python-api.rst", "rules.py"), "rules.py",
+                 "exec"), {})

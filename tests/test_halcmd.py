@@ -35,7 +35,7 @@ import pytest
 
 from halsdk import halcmd
 from halsdk.core import _core
-from halsdk.halcmd import Executor, logical_lines, parse_value, tokenize
+from halsdk.halcmd import CommandRunner, logical_lines, parse_value, tokenize
 from halsdk.halcmd.lexer import IniFile, SubstitutionError
 
 NOTE = "Note: Using POSIX non-realtime"
@@ -195,8 +195,8 @@ class _Capture:
         self.out: list[str] = []
         self.err: list[str] = []
 
-    def executor(self, hal, **kw) -> Executor:
-        return Executor(hal, out=self.out.append, err=self.err.append, **kw)
+    def executor(self, hal, **kw) -> CommandRunner:
+        return CommandRunner(hal, out=self.out.append, err=self.err.append, **kw)
 
 
 def test_executor_in_process(hal, tmp_path):
@@ -405,8 +405,8 @@ def test_status_mem_counts(hal):
 def test_completions(hal):
     from halsdk.halcmd.cli import _completions
     hal.loadrt("and2")
-    assert _completions("ne", True) == ["net", "newinst", "newsig"]
-    assert _completions("and2.0.i", False) == ["and2.0.in0", "and2.0.in1"]
+    assert _completions(hal, "ne", True) == ["net", "newinst", "newsig"]
+    assert _completions(hal, "and2.0.i", False) == ["and2.0.in0", "and2.0.in1"]
 
 
 def test_help_lists_every_command(hal):

@@ -24,7 +24,7 @@ from pathlib import Path
 import pytest
 
 from halsdk.core import _core
-from halsdk.halcmd import Executor
+from halsdk.halcmd import CommandRunner
 
 STREAMS = Path(__file__).parent / "data" / "streams"
 NOTE = "Note: Using POSIX non-realtime"
@@ -152,8 +152,8 @@ def test_waitusr_waits_for_exit(tmp_path: Path):
     assert _shm_left(env) == []
 
 
-def _executor(hal, out: list, err: list) -> Executor:
-    return Executor(hal, out=out.append, err=err.append, register=False)
+def _executor(hal, out: list, err: list) -> CommandRunner:
+    return CommandRunner(hal, out=out.append, err=err.append, register=False)
 
 
 def test_status_all_and_default(hal):

@@ -11,9 +11,10 @@ import time
 from dataclasses import dataclass
 from typing import Any, Callable, Optional
 
+from halsdk import Hal
 from halsdk.component import Component, component
-from halsdk.core import _core
 from halsdk.errors import HalError
+from halsdk.types import type_word
 
 from . import payload
 from .client import Link
@@ -120,10 +121,11 @@ class Bridge:
 
     def _resolve(self, kind: str, name: str) -> Item:
         kinds = [kind] if kind else ["pin", "param", "signal"]
+        hal = Hal.current()
         for k in kinds:
-            obj = _core.find(k, name)
+            obj = hal.find(k, name) if hal is not None else None
             if obj is not None:
-                return Item(name, obj, _core.TYPE_NAMES[obj.type])
+                return Item(name, obj, type_word(obj.type))
         what = kind or "pin, param or signal"
         raise ConfigError(f"{self.cfg.name}: key {name!r}: no {what} of "
                           "that name")

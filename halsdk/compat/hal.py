@@ -32,9 +32,8 @@ import threading
 from typing import Any, Optional, Union
 
 import halsdk
-from halsdk.core import _core
-from halsdk.core import instance as _instance
-from halsdk.errors import HalError, InvalidError, StaleError
+from halsdk.errors import HalError, Rule, StaleError
+from halsdk.types import INT_RANGES, Direction, HalType
 
 __all__ = [
     "HAL_BIT", "HAL_FLOAT", "HAL_S32", "HAL_U32", "HAL_S64", "HAL_U64",
@@ -74,16 +73,9 @@ is_sim = 1
 is_userspace = 1
 kernel_version = "Not Available"
 
-_TYPE_NAMES = {HAL_BIT: "BIT", HAL_FLOAT: "FLOAT", HAL_S32: "S32",
-               HAL_U32: "U32", HAL_S64: "S64", HAL_U64: "U64"}
-_DIR_NAMES = {HAL_IN: "IN", HAL_OUT: "OUT", HAL_IO: "IO", HAL_RO: "RO",
-              HAL_RW: "RW"}
-_INT_RANGE = {
-    HAL_S32: (-(1 << 31), (1 << 31) - 1),
-    HAL_U32: (0, (1 << 32) - 1),
-    HAL_S64: (-(1 << 63), (1 << 63) - 1),
-    HAL_U64: (0, (1 << 64) - 1),
-}
+# the reference's words are the enum names: BIT, S32, IN, IO, RO, ...
+_TYPE_NAMES = {int(t): t.name for t in HalType}
+_DIR_NAMES = {int(d): d.name for d in Direction}
 _CLOSED = "Invalid operation on closed HAL component"
 _NO_COMPONENT = "Cannot call before creating component"
 
@@ -105,9 +97,12 @@ def _need_str(value: Any, position: int) -> str:
     return value
 
 
-def _need_instance() -> None:
-    if _instance.current() is None or not _core.attached():
+def _need_instance() -> halsdk.Hal:
+    """The instance this process uses (RuntimeError if none)."""
+    hal = halsdk.Hal.current()
+    if hal is None:
         raise RuntimeError(_NO_COMPONENT)
+    return hal
 
 
 def _convert(htype: int, value: Any) -> Value:
@@ -123,7 +118,7 @@ def _convert(htype: int, value: Any) -> Value:
             raise TypeError(f"Number expected, not "
                             f"{type(value).__name__}") from None
     number = int(value)
-    lo, hi = _INT_RANGE[htype]
+    lo, hi = INT_RANGES[HalType(htype)]
     if not -(1 << 63) <= number <= max(hi, (1 << 63) - 1):
         raise OverflowError("int too big to convert")
     if not lo <= number <= hi:
@@ -507,15 +502,13 @@ class shm:  # noqa: N801 - the reference's name
 def component_exists(name: str, /) -> bool:
     """True if a component of that name exists."""
     _need_str(name, 1)
-    _need_instance()
-    return _core.find("component", name) is not None
+    return _need_instance().find("component", name) is not None
 
 
 def component_is_ready(name: str, /) -> bool:
     """True if a component of that name exists and is ready."""
     _need_str(name, 1)
-    _need_instance()
-    comp = _core.find("component", name)
+    comp = _need_instance().find("component", name)
     return bool(comp is not None and comp.ready)
 
 
@@ -524,9 +517,9 @@ def connect(pin_name: str, signal_name: str, /) -> bool:
     success and True on failure (the error is printed to stderr)."""
     _need_str(pin_name, 1)
     _need_str(signal_name, 2)
-    _need_instance()
+    hal = _need_instance()
     try:
-        _core.link(pin_name, signal_name)
+        hal.linkps(pin_name, signal_name)
     except HalError as exc:
         return _report(exc)
     return False
@@ -536,9 +529,9 @@ def disconnect(pin_name: str, /) -> bool:
     """Unlink a pin from its signal (no-op if unlinked).  False on
     success, True on failure."""
     _need_str(pin_name, 1)
-    _need_instance()
+    hal = _need_instance()
     try:
-        _core.unlink(pin_name)
+        hal.unlinkp(pin_name)
     except HalError as exc:
         return _report(exc)
     return False
@@ -549,11 +542,11 @@ def new_sig(signal_name: str, htype: int, /) -> bool:
     on failure (e.g. a duplicate name)."""
     _need_str(signal_name, 1)
     htype = operator.index(htype)
-    _need_instance()
+    hal = _need_instance()
     if htype not in _TYPE_NAMES:
         raise RuntimeError("not a valid HAL signal type")
     try:
-        _core.signal_new(signal_name, htype)
+        hal.newsig(signal_name, htype)
     except HalError as exc:
         return _report(exc)
     return False
@@ -565,34 +558,29 @@ def set_p(name: str, value: str, /) -> bool:
     RuntimeError for an unknown, output, linked or read-only item."""
     _need_str(name, 1)
     _need_str(value, 2)
-    _need_instance()
-    target = _core.find("pin", name)
-    if target is not None:
-        if target.direction == HAL_OUT:
-            raise RuntimeError("pin not writable")
-        if target.linked:
-            raise RuntimeError("pin connected to signal")
-    else:
-        target = _core.find("param", name)
-        if target is None:
-            raise RuntimeError("pin not found")
-        if target.direction == HAL_RO:
-            raise RuntimeError("param not writable")
+    hal = _need_instance()
     try:
-        target.setp(value)
-    except InvalidError:
-        return True
+        hal.setp(name, value)
     except HalError as exc:
-        raise RuntimeError(str(exc)) from exc
+        if exc.rule == Rule.BAD_VALUE:
+            return True
+        raise RuntimeError(_SET_P_WORDS.get(exc.rule, str(exc))) from exc
     return False
+
+
+# the reference module's words for a refused set_p
+_SET_P_WORDS = {Rule.NOT_FOUND: "pin not found",
+                Rule.WRITE_OUTPUT: "pin not writable",
+                Rule.PIN_CONNECTED: "pin connected to signal",
+                Rule.RO_PARAM: "param not writable"}
 
 
 def get_value(name: str, /) -> Value:
     """The value of a pin, param or signal."""
     _need_str(name, 1)
-    _need_instance()
+    hal = _need_instance()
     for kind in ("pin", "param", "signal"):
-        found = _core.find(kind, name)
+        found = hal.find(kind, name)
         if found is not None:
             return found.value
     raise RuntimeError(f"Can't set value: pin / param {name} not found")
@@ -601,8 +589,7 @@ def get_value(name: str, /) -> Value:
 def pin_has_writer(name: str, /) -> bool:
     """True if the pin is linked to a signal that has an output pin."""
     _need_str(name, 1)
-    _need_instance()
-    pin = _core.find("pin", name)
+    pin = _need_instance().find("pin", name)
     if pin is None:
         raise NameError(f"Pin `{name}' does not exist")
     sig = pin.signal
@@ -610,7 +597,7 @@ def pin_has_writer(name: str, /) -> bool:
 
 
 def _sorted(kind: str) -> list:
-    return sorted(_core.items(kind), key=lambda it: it.name)
+    return sorted(_need_instance().items(kind), key=lambda it: it.name)
 
 
 def get_info_pins() -> list[dict[str, Any]]:
@@ -647,8 +634,9 @@ _msg_level = MSG_ERR        # used while no instance is attached
 
 def get_msg_level() -> int:
     """The message level (MSG_NONE .. MSG_ALL) of the instance."""
-    if _core.attached():
-        return _core.info()["msg_level"]
+    hal = halsdk.Hal.current()
+    if hal is not None:
+        return hal.msg_level
     return _msg_level
 
 
@@ -658,5 +646,6 @@ def set_msg_level(level: int, /) -> None:
     global _msg_level
     level = min(max(operator.index(level), MSG_NONE), MSG_ALL)
     _msg_level = level
-    if _core.attached():
-        _core.set_msg_level(level)
+    hal = halsdk.Hal.current()
+    if hal is not None:
+        hal.msg_level = level

@@ -12,6 +12,7 @@ from libc.stdint cimport int16_t, int32_t, int64_t, uint8_t, uint16_t, \
 from libc.string cimport memset
 from cpython.pycapsule cimport PyCapsule_New
 from cpython.ref cimport PyObject, Py_INCREF, Py_DECREF
+from cpython.mem cimport PyMem_Malloc, PyMem_Free
 
 import os
 import re
@@ -37,6 +38,18 @@ cdef extern from "hal_core.h" nogil:
         HALSDK_U64, HALSDK_IN, HALSDK_OUT, HALSDK_IO, HALSDK_RO, HALSDK_RW
         HALSDK_COMP_USER, HALSDK_COMP_RT, HALSDK_NAME_LEN
         HAL_LOCK_PARAMS, HAL_DEFAULT_SIZE, HAL_ABI_VERSION
+        HAL_SET_IGNORE_LOCK
+
+    enum hal_rule:
+        HAL_RULE_NONE, HAL_RULE_NOT_FOUND, HAL_RULE_EXISTS,
+        HAL_RULE_BAD_NAME, HAL_RULE_LOCKED, HAL_RULE_PIN_LINKED,
+        HAL_RULE_TYPE_MISMATCH, HAL_RULE_SECOND_WRITER,
+        HAL_RULE_WRITER_AND_IO, HAL_RULE_NAME_IS_PIN, HAL_RULE_NO_PINS,
+        HAL_RULE_SIG_HAS_WRITER, HAL_RULE_WRITE_OUTPUT,
+        HAL_RULE_PIN_CONNECTED, HAL_RULE_RO_PARAM, HAL_RULE_NOT_REENTRANT,
+        HAL_RULE_NEEDS_FP, HAL_RULE_BAD_POSITION, HAL_RULE_FUNCT_UNUSED,
+        HAL_RULE_NOT_IN_THREAD, HAL_RULE_HOST_ONLY, HAL_RULE_NOT_OWNER,
+        HAL_RULE_FULL, HAL_RULE_BAD_ARG, HAL_RULE_NRULES
 
     ctypedef struct hal_obj_t:
         hoff_t next, prev
@@ -149,6 +162,11 @@ cdef extern from "hal_core.h" nogil:
     const halsdk_api halsdk_api_table
 
     const char *hal_last_error()
+    int hal_last_rule()
+    int hal_last_kind()
+    const char *hal_last_name(int index)
+    int hal_check_settable(const hal_obj_t *o, int flags)
+    int hal_net(const char *sig, const char *const *pins, int npins)
     int hal_fail(int err, const char *fmt, ...)
     int hal_instance_create(const char *shm, const char *inst, long size)
     int hal_instance_attach(const char *shm)
@@ -264,26 +282,62 @@ DIR_NAMES = {IN: "IN", OUT: "OUT", IO: "I/O", RO: "RO", RW: "RW"}
 _C_API = PyCapsule_New(<void *>&halsdk_api_table,
                        b"halsdk.core._core._C_API", NULL)
 
-_ERRNO_CLASS = {
-    2: _errors.NotFoundError,        # ENOENT
-    17: _errors.ExistsError,         # EEXIST
-    91: _errors.HalTypeError,        # EPROTOTYPE
-    16: _errors.ConflictError,       # EBUSY
-    1: _errors.NotPermittedError,    # EPERM
-    12: _errors.CapacityError,       # ENOMEM
-    28: _errors.CapacityError,       # ENOSPC
-    22: _errors.InvalidError,        # EINVAL
-    71: _errors.InstanceError,       # EPROTO
-    19: _errors.InstanceError,       # ENODEV
+
+
+# the C enum hal_rule -> halsdk.errors.Rule (a test checks they agree)
+RULES = {
+    HAL_RULE_NONE: "NONE", HAL_RULE_NOT_FOUND: "NOT_FOUND",
+    HAL_RULE_EXISTS: "EXISTS", HAL_RULE_BAD_NAME: "BAD_NAME",
+    HAL_RULE_LOCKED: "LOCKED", HAL_RULE_PIN_LINKED: "PIN_LINKED",
+    HAL_RULE_TYPE_MISMATCH: "TYPE_MISMATCH",
+    HAL_RULE_SECOND_WRITER: "SECOND_WRITER",
+    HAL_RULE_WRITER_AND_IO: "WRITER_AND_IO",
+    HAL_RULE_NAME_IS_PIN: "NAME_IS_PIN", HAL_RULE_NO_PINS: "NO_PINS",
+    HAL_RULE_SIG_HAS_WRITER: "SIG_HAS_WRITER",
+    HAL_RULE_WRITE_OUTPUT: "WRITE_OUTPUT",
+    HAL_RULE_PIN_CONNECTED: "PIN_CONNECTED",
+    HAL_RULE_RO_PARAM: "RO_PARAM", HAL_RULE_NOT_REENTRANT: "NOT_REENTRANT",
+    HAL_RULE_NEEDS_FP: "NEEDS_FP", HAL_RULE_BAD_POSITION: "BAD_POSITION",
+    HAL_RULE_FUNCT_UNUSED: "FUNCT_UNUSED",
+    HAL_RULE_NOT_IN_THREAD: "NOT_IN_THREAD",
+    HAL_RULE_HOST_ONLY: "HOST_ONLY", HAL_RULE_NOT_OWNER: "NOT_OWNER",
+    HAL_RULE_FULL: "FULL", HAL_RULE_BAD_ARG: "BAD_ARG",
 }
+assert len(RULES) == HAL_RULE_NRULES
+
+
+def error_of(int r):
+    """The exception of a negative core return: its class by errno, its
+    rule, kind and names from the core's last failure."""
+    msg = hal_last_error().decode("utf-8", "replace")
+    cdef int kind = hal_last_kind()
+    names = []
+    for i in range(3):
+        n = hal_last_name(i).decode("utf-8", "replace")
+        if n:
+            names.append(n)
+    return _errors.error_for_errno(
+        r, msg, rule=_errors.Rule(RULES.get(hal_last_rule(), "NONE")),
+        kind=KIND_WORDS.get(kind), names=tuple(names))
 
 
 cdef int check(int r) except -1:
     """Raise the exception of a negative core return."""
     if r >= 0:
         return r
-    msg = hal_last_error().decode("utf-8", "replace")
-    raise _ERRNO_CLASS.get(-r, _errors.HalError)(msg)
+    raise error_of(r)
+
+
+cdef object _values = None
+
+
+cdef object coerce(int type, value, str what, bint wrap=False):
+    """halsdk.values.coerce (imported on first use: it imports us)."""
+    global _values
+    if _values is None:
+        from halsdk import values
+        _values = values
+    return _values.coerce(type, value, what, wrap)
 
 
 cdef int lock() except -1:
@@ -356,56 +410,6 @@ def c_integer(str text):
     else:
         v = int(body, 10)
     return -v if sign == "-" else v
-
-
-def parse_value(int type, value, str what):
-    """Convert a Python value or a halcmd-style string for a HAL type."""
-    tname = TYPE_NAMES.get(type, "?")
-    if type == HALSDK_BIT:
-        if isinstance(value, str):
-            s = value.strip()
-            if s == "1" or s.lower() == "true":
-                return True
-            if s == "0" or s.lower() == "false":
-                return False
-        elif isinstance(value, (bool, int)) and value in (0, 1):
-            return bool(value)
-        elif hasattr(value, "__index__") and int(value) in (0, 1):
-            return bool(int(value))
-        raise _errors.InvalidError(
-            f"value '{value}' for {what} is not a bit (0, 1, TRUE or FALSE)")
-    if type == HALSDK_FLOAT:
-        try:
-            if isinstance(value, bool):
-                return float(value)
-            if isinstance(value, str):
-                # as C's strtod reads it: no digit separators; hex floats
-                s = value.strip()
-                if "_" in s:
-                    raise ValueError
-                return float.fromhex(s) if "0x" in s.lower() else float(s)
-            return float(value)
-        except (TypeError, ValueError):
-            raise _errors.InvalidError(
-                f"value '{value}' for {what} is not a float") from None
-    try:
-        if isinstance(value, str):
-            v = c_integer(value)
-        elif isinstance(value, float):
-            if not value.is_integer():
-                raise ValueError
-            v = int(value)
-        else:
-            v = int(value.__index__())
-    except (TypeError, ValueError, AttributeError):
-        raise _errors.InvalidError(
-            f"value '{value}' for {what} is not an integer") from None
-    lo, hi = _INT_RANGE[type]
-    if not lo <= v <= hi:
-        raise _errors.InvalidError(
-            f"value {v} for {what} is out of range for {tname} "
-            f"({lo} .. {hi})")
-    return v
 
 
 cdef int put_raw(int type, void *p, object v) except -1:
@@ -496,9 +500,6 @@ cdef class ValueItem(Item):
     cdef void *data(self) except NULL:
         raise NotImplementedError
 
-    cdef int check_setp(self, hal_item_t *it) except -1:
-        raise NotImplementedError
-
     @property
     def type(self) -> int:
         """HAL type number (see :class:`halsdk.HalType`)."""
@@ -535,22 +536,22 @@ cdef class ValueItem(Item):
     def value(self, v):
         self.setp(v)
 
-    def setp(self, v):
-        """Set the value as ``halcmd setp`` does (it refuses out pins,
-        linked pins and read-only params)."""
+    def setp(self, v, *, bint ignore_lock=False, bint wrap=False):
+        """Set the value as ``halcmd setp`` does: the core refuses out
+        pins, linked pins, read-only params and (unless ``ignore_lock``)
+        an instance locked against setting values.  ``wrap``: read a
+        word exactly as halcmd does (see :func:`halsdk.values.coerce`)."""
         cdef hal_item_t *it = <hal_item_t *>self.rec()
-        if hal_map.hdr.lock & HAL_LOCK_PARAMS:
-            raise _errors.NotPermittedError(
-                f"cannot set {KIND_WORDS[self.kind]} '{self._name}': HAL is "
-                "locked against setting values")
-        self.check_setp(it)
-        v = parse_value(it.type, v, f"{KIND_WORDS[self.kind]} '{self._name}'")
+        check(hal_check_settable(<hal_obj_t *>it,
+                                 HAL_SET_IGNORE_LOCK if ignore_lock else 0))
+        v = coerce(it.type, v, f"{KIND_WORDS[self.kind]} '{self._name}'",
+                   wrap)
         put_raw(it.type, self.data(), v)
 
     def write(self, v):
         """Write the value as the owning component does (any direction)."""
         cdef hal_item_t *it = <hal_item_t *>self.rec()
-        v = parse_value(it.type, v, f"{KIND_WORDS[self.kind]} '{self._name}'")
+        v = coerce(it.type, v, f"{KIND_WORDS[self.kind]} '{self._name}'")
         put_raw(it.type, self.data(), v)
 
 
@@ -559,15 +560,6 @@ cdef class Pin(ValueItem):
 
     cdef void *data(self) except NULL:
         return hal_pin_value(<hal_pin_t *>self.rec())
-
-    cdef int check_setp(self, hal_item_t *it) except -1:
-        if it.dir == HALSDK_OUT:
-            raise _errors.NotPermittedError(
-                f"pin '{self._name}' is not writable")
-        if (<hal_pin_t *>it).signal != 0:
-            raise _errors.ConflictError(
-                f"pin '{self._name}' is connected to a signal")
-        return 0
 
     @property
     def signal(self):
@@ -589,12 +581,6 @@ cdef class Param(ValueItem):
     cdef void *data(self) except NULL:
         return hal_param_value(<hal_param_t *>self.rec())
 
-    cdef int check_setp(self, hal_item_t *it) except -1:
-        if it.dir == HALSDK_RO:
-            raise _errors.NotPermittedError(
-                f"param '{self._name}' is not writable")
-        return 0
-
 
 cdef class Signal(Item):
     """A signal: a typed wire between pins."""
@@ -613,24 +599,22 @@ cdef class Signal(Item):
     def value(self, v):
         self.sets(v)
 
-    def sets(self, v):
-        """Set the signal as ``halcmd sets`` does: only without a writer."""
+    def sets(self, v, *, bint ignore_lock=False, bint wrap=False):
+        """Set the signal as ``halcmd sets`` does: the core refuses a
+        signal with a writer and (unless ``ignore_lock``: halcmd's
+        ``sets``, as the reference's) an instance locked against setting
+        values."""
         cdef hal_sig_t *s = <hal_sig_t *>self.rec()
-        if hal_map.hdr.lock & HAL_LOCK_PARAMS:
-            raise _errors.NotPermittedError(
-                f"cannot set signal '{self._name}': HAL is locked against "
-                "setting values")
-        if s.writers > 0:
-            raise _errors.ConflictError(
-                f"signal '{self._name}' already has writer(s)")
-        v = parse_value(s.type, v, f"signal '{self._name}'")
+        check(hal_check_settable(<hal_obj_t *>s,
+                                 HAL_SET_IGNORE_LOCK if ignore_lock else 0))
+        v = coerce(s.type, v, f"signal '{self._name}'", wrap)
         put_raw(s.type, &s.value, v)
 
     def write(self, v):
-        """Write the value whatever its writers and the lock: for tools
-        (halcmd's ``sets``, which the reference does not lock)."""
+        """Write the value whatever its writers and the lock (what the
+        signal's writer does)."""
         cdef hal_sig_t *s = <hal_sig_t *>self.rec()
-        v = parse_value(s.type, v, f"signal '{self._name}'")
+        v = coerce(s.type, v, f"signal '{self._name}'")
         put_raw(s.type, &s.value, v)
 
     @property
@@ -902,7 +886,7 @@ cdef class Stream(Item):
         memset(rec, 0, sizeof(rec))
         for i in range(n):
             t = st.types[i]
-            v = parse_value(t, vals[i], f"value {i} of stream '{self._name}'")
+            v = coerce(t, vals[i], f"value {i} of stream '{self._name}'")
             put_raw(t, &rec[i], v)
         cdef int r = hal_stream_write(self.handle(), rec)
         if r == -28:        # ENOSPC
@@ -1284,6 +1268,29 @@ def link(pin, sig):
     cdef int r
     with nogil:
         r = hal_link(ca, cb)
+    check(r)
+
+
+def net(sig, pins):
+    """Link pins to a signal atomically, creating it with the first
+    pin's type (hal_net)."""
+    need_instance()
+    cdef bytes s = enc(sig)
+    encoded = [enc(p) for p in pins]
+    cdef int n = len(encoded)
+    cdef const char **arr = <const char **>PyMem_Malloc(
+        (n if n else 1) * sizeof(const char *))
+    if arr == NULL:
+        raise MemoryError()
+    cdef const char *cs = s
+    cdef int r
+    try:
+        for i in range(n):
+            arr[i] = <const char *>encoded[i]
+        with nogil:
+            r = hal_net(cs, arr, n)
+    finally:
+        PyMem_Free(arr)
     check(r)
 
 

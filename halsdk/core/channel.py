@@ -156,8 +156,12 @@ class Server:
         try:
             return {"ok": True, "result": handler(*args, **kwargs)}
         except Exception as exc:
-            return {"ok": False, "error": str(exc),
-                    "class": type(exc).__name__}
+            reply = {"ok": False, "error": str(exc),
+                     "class": type(exc).__name__}
+            if isinstance(exc, errors.HalError):
+                reply.update(rule=exc.rule.value, kind=exc.kind,
+                             names=list(exc.names))
+            return reply
 
 
 def request(shm: str, op: str, *args: Any, timeout: float = 60.0,
@@ -195,4 +199,9 @@ def request(shm: str, op: str, *args: Any, timeout: float = 60.0,
     cls = getattr(errors, reply.get("class", ""), None)
     if not (isinstance(cls, type) and issubclass(cls, errors.HalError)):
         cls = errors.HalError
-    raise cls(reply.get("error", "request failed"))
+    try:
+        rule = errors.Rule(reply.get("rule", "NONE"))
+    except ValueError:
+        rule = errors.Rule.NONE
+    raise cls(reply.get("error", "request failed"), rule=rule,
+              kind=reply.get("kind"), names=tuple(reply.get("names", ())))

@@ -38,14 +38,22 @@ import sys
 from dataclasses import dataclass
 from typing import Optional
 
-from halsdk.core import _core
-from halsdk.halcmd.commands import ARROWS, REFERENCE_NAME_LEN, Executor
+from halsdk.errors import HalError, Rule
+from halsdk.halcmd.commands import (
+    ARROWS,
+    REFERENCE_NAME_LEN,
+    CommandError,
+    CommandRunner,
+)
+from halsdk.types import Direction, type_word
 
 _NAME_OK = re.compile(r"[a-z0-9._-]+")
 # commands that would run something or write files: not executed
 _SKIPPED = ("start", "stop", "loadusr", "waitusr", "unloadusr", "save",
             "setexact_for_test_suite_only")
-_DIR = {_core.IN: "in", _core.OUT: "out", _core.IO: "io"}
+_DIR = {Direction.IN: "in", Direction.OUT: "out", Direction.IO: "io"}
+# the refusals of a link that _explain details
+_LINK_RULES = (Rule.TYPE_MISMATCH, Rule.SECOND_WRITER, Rule.WRITER_AND_IO)
 
 
 @dataclass(frozen=True)
@@ -64,7 +72,7 @@ class Finding:
 Loc = tuple[str, int]
 
 
-class CheckExecutor(Executor):
+class CheckRunner(CommandRunner):
     """An executor that records where objects come from and what went
     wrong, without running threads or programs."""
 
@@ -82,6 +90,7 @@ class CheckExecutor(Executor):
         self._captured: list[str] = []
         self._specific: Optional[Loc] = None
         self._serial = 0
+        self._refused: Optional[Rule] = None
 
     # ------------------------------------------------------------ records
 
@@ -157,28 +166,43 @@ class CheckExecutor(Executor):
 
     # ------------------------------------------------------------ commands
 
+    def failure(self, command: str, exc: HalError, variant=None,
+                **fields) -> CommandError:
+        self._refused = exc.rule
+        return super().failure(command, exc, variant, **fields)
+
     def cmd_net(self, args: list[str]) -> None:
         signame = args[0]
         names = [a for a in args[1:] if a not in ARROWS]
-        pins = [p for p in (_core.find("pin", n) for n in names)
+        pins = [p for p in (self.hal.find("pin", n) for n in names)
                 if p is not None]
-        sig = _core.find("signal", signame)
-        self._precheck(signame, sig, pins)
-        super().cmd_net(args)
+        sig = self.hal.find("signal", signame)
+        self._linking(signame, sig, pins, super().cmd_net, args)
         for pin in pins:
             self.linked_at.setdefault(pin.name, self.loc)
 
     def _link(self, pin_name: str, sig_name: str, what: str) -> None:
-        pin = _core.find("pin", pin_name)
-        sig = _core.find("signal", sig_name)
-        if pin is not None and sig is not None:
-            self._precheck(sig_name, sig, [pin])
-        super()._link(pin_name, sig_name, what)
+        pin = self.hal.find("pin", pin_name)
+        sig = self.hal.find("signal", sig_name)
+        self._linking(sig_name, sig, [pin] if pin is not None else [],
+                      super()._link, pin_name, sig_name, what)
         if pin is not None:
             self.linked_at.setdefault(pin.name, self.loc)
 
-    def _precheck(self, signame: str, sig, new_pins: list) -> None:
-        """Multiple writers, type and direction conflicts of a link."""
+    def _linking(self, signame: str, sig, pins: list, run, *args) -> None:
+        """Run a linking command; when the core refuses it for a type or
+        a writer conflict, explain which pins conflict."""
+        self._refused = None
+        try:
+            run(*args)
+        except CommandError:
+            if self._refused in _LINK_RULES and (sig is not None
+                                                 or pins):
+                self._explain(signame, sig, pins)
+            raise
+
+    def _explain(self, signame: str, sig, new_pins: list) -> None:
+        """The type and writer conflicts of a refused link, all of them."""
         pins = {p.name: p for p in (sig.pins if sig is not None else [])}
         for pin in new_pins:
             pins.setdefault(pin.name, pin)
@@ -188,11 +212,12 @@ class CheckExecutor(Executor):
             if pin.type != stype:
                 self._specific = self.loc
                 self.add("error", f"type mismatch: pin '{pin.name}' is "
-                         f"{_core.TYPE_NAMES[pin.type]}, signal '{signame}' "
-                         f"is {_core.TYPE_NAMES[stype]}")
+                         f"{type_word(pin.type)}, signal '{signame}' "
+                         f"is {type_word(stype)}")
         outs = sorted(n for n, p in pins.items()
-                      if p.direction == _core.OUT)
-        ios = sorted(n for n, p in pins.items() if p.direction == _core.IO)
+                      if p.direction == Direction.OUT)
+        ios = sorted(n for n, p in pins.items()
+                     if p.direction == Direction.IO)
         if len(outs) > 1:
             self._specific = self.loc
             self.add("error", f"signal '{signame}' has more than one "
@@ -213,7 +238,7 @@ class CheckExecutor(Executor):
 
     def cmd_setp(self, args: list[str], name: str = "setp") -> None:
         super().cmd_setp(args, name)
-        item = _core.find("pin", args[0])
+        item = self.hal.find("pin", args[0])
         if item is not None:
             self.setp_pins.add(item.name)
 
@@ -235,7 +260,7 @@ class CheckExecutor(Executor):
         return self.origin.get((kind, name), (self.filename or "?", 0))
 
     def _signals(self) -> None:
-        for sig in _core.items("signal"):
+        for sig in self.hal.items("signal"):
             loc = self._where("signal", sig.name)
             if not sig.pins:
                 self.add("warning", f"signal '{sig.name}' has no pins", loc)
@@ -247,16 +272,16 @@ class CheckExecutor(Executor):
                          "with sets", loc)
 
     def _inputs(self) -> None:
-        for pin in _core.items("pin"):
+        for pin in self.hal.items("pin"):
             loc = self.origin.get(("pin", pin.name))
-            if loc is None or pin.direction != _core.IN or pin.linked or \
+            if loc is None or pin.direction != Direction.IN or pin.linked or \
                     pin.name in self.setp_pins:
                 continue
             self.add("warning", f"input pin '{pin.name}' is not connected "
                      "and never set with setp", loc)
 
     def _functions(self) -> None:
-        for funct in _core.items("function"):
+        for funct in self.hal.items("function"):
             if funct.users == 0:
                 self.add("warning", f"function '{funct.name}' is never "
                          "added to a thread",
@@ -264,20 +289,20 @@ class CheckExecutor(Executor):
 
     def _order(self) -> None:
         functs: dict[int, list[str]] = {}
-        for funct in _core.items("function"):
+        for funct in self.hal.items("function"):
             functs.setdefault(funct.owner_id, []).append(funct.name)
         threads = [(t.name, {f: i for i, f in enumerate(t.functions)})
-                   for t in _core.items("thread")]
-        for sig in _core.items("signal"):
+                   for t in self.hal.items("thread")]
+        for sig in self.hal.items("signal"):
             writers = [p for p in sig.pins
-                       if p.direction in (_core.OUT, _core.IO)]
+                       if p.direction in (Direction.OUT, Direction.IO)]
             if len(writers) != 1:
                 continue
             wf = _function_of(writers[0], functs)
             if wf is None:
                 continue
             for reader in sig.pins:
-                if reader.direction != _core.IN:
+                if reader.direction != Direction.IN:
                     continue
                 rf = _function_of(reader, functs)
                 if rf is None or rf == wf:
@@ -334,7 +359,7 @@ def check_file(path: str, ini: Optional[str] = None) -> list[Finding]:
     from halsdk import Hal
     files: dict[str, int] = {path: 0}
     with Hal(instance=f"check-{os.getpid()}", create=True) as hal:
-        ex = CheckExecutor(hal, ini=ini)
+        ex = CheckRunner(hal, ini=ini)
         ex.run_file(path)
         if ex._captured and not ex.findings:
             # the file itself could not be opened

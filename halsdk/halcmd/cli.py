@@ -11,7 +11,7 @@ from __future__ import annotations
 import sys
 from typing import Optional
 
-from halsdk.halcmd.commands import Executor, Quit
+from halsdk.halcmd.commands import CommandRunner, Quit
 
 _HALCMD_USAGE = """\
 Usage:  halcmd [options] [cmd [args]]
@@ -128,20 +128,19 @@ def _die(prog: str, message: str, usage: str) -> None:
     raise SystemExit(1)
 
 
-def _completions(text: str, first_word: bool) -> list[str]:
+def _completions(hal, text: str, first_word: bool) -> list[str]:
     """Command names for the first word, HAL names after it."""
-    from halsdk.core import _core
     from halsdk.halcmd.commands import ARG_COUNTS
     if first_word:
         names = list(ARG_COUNTS)
     else:
         names = [it.name for kind in ("pin", "param", "signal", "function",
                                       "thread", "component")
-                 for it in _core.items(kind)]
+                 for it in hal.items(kind)]
     return sorted(n for n in names if n.startswith(text))
 
 
-def _setup_readline() -> None:
+def _setup_readline(hal) -> None:
     try:
         import readline
     except ImportError:
@@ -151,7 +150,7 @@ def _setup_readline() -> None:
     def complete(text: str, n: int):
         if n == 0:
             before = readline.get_line_buffer()[:readline.get_begidx()]
-            state["m"] = _completions(text, not before.strip())
+            state["m"] = _completions(hal, text, not before.strip())
         found = state.get("m", [])
         return found[n] if n < len(found) else None
 
@@ -160,11 +159,11 @@ def _setup_readline() -> None:
     readline.parse_and_bind("tab: complete")
 
 
-def _interactive(ex: Executor) -> None:
+def _interactive(ex: CommandRunner) -> None:
     """A simple prompt with readline history when it is available."""
     tty = sys.stdin.isatty()
     if tty:
-        _setup_readline()
+        _setup_readline(ex.hal)
     ex.filename = "<stdin>"
     ex.lineno = 0
     while True:
@@ -181,7 +180,7 @@ def _interactive(ex: Executor) -> None:
         ex.run_line(line)
 
 
-def _run(ex: Executor, opts: _Options, prog: str) -> int:
+def _run(ex: CommandRunner, opts: _Options, prog: str) -> int:
     """Run the file, the command words or the prompt; exit status."""
     try:
         if opts.file is not None and prog == "halrun" and \
@@ -206,7 +205,7 @@ def _run(ex: Executor, opts: _Options, prog: str) -> int:
     return 1 if ex.errors else 0
 
 
-def _twopass(ex: Executor, path: str) -> int:
+def _twopass(ex: CommandRunner, path: str) -> int:
     """``halrun FILE.ini``: twopass loading, as the reference does it."""
     from halsdk.halcmd import twopass
     try:
@@ -244,17 +243,16 @@ def _check(opts: _Options, prog: str) -> int:
     return check.main(path, ini=opts.ini)
 
 
-def _teardown(hal, ex: Executor, opts: _Options) -> None:
+def _teardown(hal, ex: CommandRunner, opts: _Options) -> None:
     """What the end of halrun does: stop threads, end loadusr programs."""
-    from halsdk.core import _core
     from halsdk.errors import HalError
-    if _core.get_lock() & 8:
+    if hal.lock_level & hal.LOCK_RUN:
         # the reference's teardown cannot stop threads under a run lock
         # and says so; the instance is removed anyway
         if opts.verbose >= 0:
             sys.stderr.write("HAL: ERROR: stop_threads called while HAL "
                              "is locked\n")
-        _core.set_lock(0)
+        hal.lock_level = 0
     try:
         hal.stop()
     except HalError:
@@ -281,7 +279,7 @@ def halcmd_main(argv: Optional[list[str]] = None) -> int:
               "start one with halrun", file=sys.stderr)
         return 1
     with hal:
-        ex = Executor(hal, keep_going=opts.keep_going, script=opts.script,
+        ex = CommandRunner(hal, keep_going=opts.keep_going, script=opts.script,
                       verbose=opts.verbose, ini=opts.ini, echo=opts.echo)
         try:
             return _run(ex, opts, "halcmd")
@@ -318,7 +316,7 @@ def halrun_main(argv: Optional[list[str]] = None) -> int:
               "instances of dead processes)", file=sys.stderr)
         return 1
     with hal:
-        ex = Executor(hal, keep_going=opts.keep_going, script=opts.script,
+        ex = CommandRunner(hal, keep_going=opts.keep_going, script=opts.script,
                       verbose=opts.verbose, ini=opts.ini, echo=opts.echo)
         try:
             return _run(ex, opts, "halrun")

@@ -1,6 +1,6 @@
-"""The HAL command executor shared by halrun, halcmd and Python.
+"""The HAL command runner shared by halrun, halcmd and Python.
 
-:class:`Executor` runs one command (a list of words) or a whole file and
+:class:`CommandRunner` runs one command (a list of words) or a whole file and
 prints what the reference halcmd prints: results to ``out``, errors to
 ``err`` as ``file:line: message`` (no prefix on the command line).
 """
@@ -16,8 +16,9 @@ import time
 from collections.abc import Iterable
 from typing import Callable, Optional
 
-from halsdk.core import _core
-from halsdk.errors import HalError
+from halsdk.component import Component
+from halsdk.errors import HalError, Rule
+from halsdk.hal import Hal
 from halsdk.halcmd.helptext import HELP
 from halsdk.halcmd.lexer import (
     IniFile,
@@ -26,24 +27,19 @@ from halsdk.halcmd.lexer import (
     strip_comment,
     tokenize,
 )
+from halsdk.halcmd.messages import lookup, words
 from halsdk.halcmd.save import Saver, status
 from halsdk.halcmd.show import Shower, type_name, value_text
+from halsdk.types import Direction, HalType, parse_type
+from halsdk.values import parse_word
 
 Out = Callable[[str], None]
 
 # lock bits of the core (same values as the reference)
-LOCK_LOAD, LOCK_CONFIG, LOCK_PARAMS, LOCK_RUN = 1, 2, 4, 8
+LOCK_LOAD, LOCK_CONFIG, LOCK_PARAMS, LOCK_RUN = (
+    Hal.LOCK_LOAD, Hal.LOCK_CONFIG, Hal.LOCK_PARAMS, Hal.LOCK_RUN)
 LOCK_WORDS = {"all": 255, "tune": LOCK_LOAD | LOCK_CONFIG, "none": 0}
 ARROWS = ("=>", "<=", "<=>")
-SIG_TYPES = {"bit": _core.BIT, "float": _core.FLOAT, "s32": _core.S32,
-             "u32": _core.U32, "s64": _core.S64, "u64": _core.U64}
-_TYPE_WORD = {_core.BIT: "bit", _core.FLOAT: "float", _core.S32: "S32",
-              _core.U32: "U32", _core.S64: "S64", _core.U64: "U64"}
-_FLOAT = re.compile(r"\s*[-+]?(\d+\.?\d*([eE][-+]?\d+)?|\.\d+([eE][-+]?\d+)?"
-                    r"|inf|infinity|nan)\s*$", re.IGNORECASE)
-_HEX_FLOAT = re.compile(r"\s*[-+]?0[xX][0-9a-fA-F]*\.?[0-9a-fA-F]*"
-                        r"([pP][-+]?\d+)?\s*$")
-_INT = re.compile(r"\s*([-+]?)(0[xX][0-9a-fA-F]+|0[0-7]*|[1-9]\d*)$")
 
 # name: (least, most) argument counts (most None: any number)
 ARG_COUNTS: dict[str, tuple[int, Optional[int]]] = {
@@ -62,7 +58,7 @@ ARG_COUNTS: dict[str, tuple[int, Optional[int]]] = {
 }
 # longest name the reference HAL accepts (its HAL_NAME_LEN)
 REFERENCE_NAME_LEN = 47
-# kinds of objects whose new names are reported to Executor.created()
+# kinds of objects whose new names are reported to CommandRunner.created()
 _CREATED_KINDS = ("component", "instance", "pin", "param", "function",
                   "thread")
 # commands whose arrows are dropped before counting arguments
@@ -84,12 +80,6 @@ def hal_error(text: str, *messages: str) -> CommandError:
     return CommandError(*messages, lines=[f"HAL: ERROR: {text}"])
 
 
-def find(kind: str, name: str):
-    """A pin, param or signal by name (pins and params also by the name
-    they had before an alias: the core looks those up too)."""
-    return _core.find(kind, name)
-
-
 def _program_path(prog: str) -> str:
     """A program for loadusr: on PATH, else a launcher that halcompile
     put in a HALSDK_PATH folder or the user component folder."""
@@ -107,38 +97,11 @@ class Quit(Exception):
     """``quit``/``exit``: stop reading commands."""
 
 
-def parse_value(t: int, text: str):
-    """Convert a word as the reference does (C strtol/strtod rules)."""
-    if t == _core.BIT:
-        if text == "1" or text.lower() == "true":
-            return True
-        if text == "0" or text.lower() == "false":
-            return False
-        raise ValueError
-    if t == _core.FLOAT:
-        if _FLOAT.match(text):
-            return float(text)
-        if not _HEX_FLOAT.match(text):
-            raise ValueError
-        return float.fromhex(text)
-    m = _INT.match(text)
-    if m is None:
-        raise ValueError
-    v = int(m.group(2), 0) if not re.fullmatch(r"0[0-7]+", m.group(2)) \
-        else int(m.group(2), 8)
-    if m.group(1) == "-":
-        v = -v
-    if t in (_core.S32, _core.S64):
-        v = max(-2**63, min(2**63 - 1, v))      # strtol saturates
-        bits = 32 if t == _core.S32 else 64
-        v &= (1 << bits) - 1                     # then C truncates
-        return v - (1 << bits) if v >> (bits - 1) else v
-    if abs(v) >= 2**64:
-        v = 2**64 - 1                            # strtoul saturates
-    return v & (0xFFFFFFFF if t == _core.U32 else 2**64 - 1)
+#: a word as halcmd reads it (kept under its old name)
+parse_value = parse_word
 
 
-class Executor:
+class CommandRunner:
     """Runs HAL commands against an instance.
 
     :param hal: a :class:`halsdk.Hal` (host or attached).
@@ -173,11 +136,12 @@ class Executor:
         self.ini = IniFile(ini) if ini else None
         self.echo = echo
         self.warn_long_names = warn_long_names
-        self.shower = Shower(self.out, script)
+        self.shower = Shower(hal, self.out, script)
         self.filename: Optional[str] = None
         self.lineno = 0
         self.errors = 0
         self.comp_id: Optional[int] = None
+        self.component: Optional[Component] = None
         self._linkpp_warned = False     # linkpp warns once per process
         self.children: list[subprocess.Popen] = []
         if register:
@@ -188,16 +152,16 @@ class Executor:
     def register(self) -> None:
         """(Re)create the ``halcmd<pid>`` component, as the newest one."""
         self.unregister()
-        cid = _core.comp_new(f"halcmd{os.getpid()}", _core.COMP_USER)
-        _core.comp_ready(cid, True)
-        self.comp_id = cid
+        comp = self.hal.new_component(f"halcmd{os.getpid()}")
+        comp.ready()
+        self.component = comp
+        self.comp_id = comp.id
 
     def unregister(self) -> None:
-        if self.comp_id is not None:
-            comp = _core.comp_by_id(self.comp_id)
-            if comp is not None:
-                _core.comp_exit(self.comp_id)
-            self.comp_id = None
+        if self.component is not None:
+            self.component.exit()
+            self.component = None
+        self.comp_id = None
 
     # ------------------------------------------------------------ running
 
@@ -334,34 +298,39 @@ class Executor:
                            f"characters long; the reference HAL accepts at "
                            f"most {REFERENCE_NAME_LEN}")
 
-    @staticmethod
-    def _counts() -> dict[str, int]:
-        return dict(_core.info()["counts"])
+    def _counts(self) -> dict[str, int]:
+        return self.hal.counts()
 
     def _report_new(self, before: dict[str, int]) -> None:
         """Report the objects created since the ``before`` counts (the
         core lists objects in creation order)."""
-        after = _core.info()["counts"]
+        after = self.hal.counts()
         for kind in _CREATED_KINDS:
             added = after[kind] - before[kind]
             if added > 0:
                 self.created(kind, [it.name for it
-                                    in _core.items(kind)[-added:]])
+                                    in self.hal.items(kind)[-added:]])
 
     def _locked(self, bit: int) -> bool:
-        return bool(_core.get_lock() & bit)
+        return bool(self.hal.lock_level & bit)
 
-    def _item(self, name: str, order: str = "pin or parameter"):
-        item = find("param", name) or find("pin", name)
+    def _item(self, name: str):
+        item = self.hal.find("param", name) or self.hal.find("pin", name)
         if item is None:
-            raise CommandError(f"{order} '{name}' not found")
+            raise CommandError(f"pin or parameter '{name}' not found")
         return item
 
-    def _signal(self, name: str):
-        sig = _core.find("signal", name)
-        if sig is None:
-            raise CommandError(f"signal '{name}' not found")
-        return sig
+    def failure(self, command: str, exc: HalError,
+                variant: Optional[str] = None, **fields) -> CommandError:
+        """The reference's words for an error of the core (messages.py);
+        an error the table does not know keeps the core's message."""
+        entry = lookup(command, exc, variant)
+        if entry is None:
+            return hal_error(str(exc), f"{command} failed")
+        hal_line, message = words(entry, exc, **fields)
+        return CommandError(*(message or "").split("\n"),
+                            lines=[f"HAL: ERROR: {hal_line}"]
+                            if hal_line is not None else [])
 
     # ------------------------------------------------------------ modules
 
@@ -396,7 +365,7 @@ class Executor:
 
     def cmd_unload(self, args: list[str]) -> None:
         registered = self.comp_id is not None
-        if args[0] != "all" and _core.find("component", args[0]) is None:
+        if args[0] != "all" and self.hal.find("component", args[0]) is None:
             raise CommandError(f"component '{args[0]}' is not loaded")
         try:
             self.hal.unload(args[0])
@@ -407,12 +376,13 @@ class Executor:
             # reference
             if registered and args[0] == "all" and (
                     self.comp_id is None
-                    or _core.comp_by_id(self.comp_id) is None):
+                    or self.hal.component_by_id(self.comp_id) is None):
+                self.component = None
                 self.comp_id = None
                 self.register()
 
     def _rt_modules(self) -> set[str]:
-        return {c.name for c in _core.items("component")
+        return {c.name for c in self.hal.items("component")
                 if c.realtime and not c.name.startswith("__")}
 
     def cmd_newinst(self, args: list[str]) -> None:
@@ -465,7 +435,7 @@ class Executor:
         if wait_ready is not None:
             name = wait_ready or os.path.basename(prog)
             while True:
-                comp = _core.find("component", name)
+                comp = self.hal.find("component", name)
                 if comp is not None and comp.ready:
                     self.info(f"Component '{name}' ready")
                     break
@@ -482,7 +452,7 @@ class Executor:
 
     def cmd_waitusr(self, args: list[str]) -> None:
         name = args[0]
-        comp = _core.find("component", name)
+        comp = self.hal.find("component", name)
         if comp is None:
             return              # nothing to wait for, as in the reference
         if comp.realtime:
@@ -494,10 +464,10 @@ class Executor:
     def cmd_unloadusr(self, args: list[str]) -> None:
         name = args[0]
         if name == "all":
-            names = [c.name for c in _core.items("component")
+            names = [c.name for c in self.hal.items("component")
                      if not c.realtime and c.id != self.comp_id]
         else:
-            comp = _core.find("component", name)
+            comp = self.hal.find("component", name)
             if comp is None:
                 return          # the reference says nothing either
             if comp.realtime:
@@ -514,78 +484,66 @@ class Executor:
 
     def cmd_newsig(self, args: list[str]) -> None:
         name, tword = args
-        t = SIG_TYPES.get(tword.lower())
-        if t is None:
-            raise CommandError(f"Unknown signal type '{tword}'",
-                               "newsig failed")
-        if self._locked(LOCK_CONFIG):
-            raise hal_error("signal_new called while HAL is locked",
-                            "newsig failed")
-        if _core.find("signal", name) is not None:
-            raise hal_error(f"duplicate signal '{name}'", "newsig failed")
         try:
-            _core.signal_new(name, t)
+            t = parse_type(tword)
+        except HalError:
+            raise CommandError(f"Unknown signal type '{tword}'",
+                               "newsig failed") from None
+        try:
+            self.hal.newsig(name, t)
         except HalError as exc:
-            raise hal_error(str(exc), "newsig failed") from None
+            raise self.failure("newsig", exc) from None
         self.created("signal", [name])
 
     def cmd_delsig(self, args: list[str]) -> None:
-        name = args[0]
-        if self._locked(LOCK_CONFIG):
-            raise hal_error("signal_delete called while HAL locked")
-        if name == "all":
-            for sig in _core.items("signal"):
-                _core.signal_delete(sig.name)
-            return
-        if _core.find("signal", name) is None:
-            raise hal_error(f"signal '{name}' not found")
-        _core.signal_delete(name)
+        try:
+            self.hal.delsig(args[0])
+        except HalError as exc:
+            raise self.failure("delsig", exc) from None
 
     def cmd_sets(self, args: list[str]) -> None:
-        sig = self._signal(args[0])
-        if sig.writers:             # io pins do not count, as in the reference
-            raise CommandError(f"signal '{args[0]}' already has writer(s)")
         try:
-            value = parse_value(sig.type, args[1])
-        except ValueError:
-            raise CommandError(
-                f"value '{args[1]}' invalid for {_value_word(sig.type)}",
-                "sets failed") from None
-        sig.write(value)            # the reference's sets ignores locks
+            # the reference's sets ignores locks
+            self.hal.sets(args[0], args[1], ignore_lock=True, wrap=True)
+        except HalError as exc:
+            raise self._value_failure("sets", exc, "signal", args[0],
+                                      args[1]) from None
 
     def cmd_gets(self, args: list[str]) -> None:
-        sig = self._signal(args[0])
+        try:
+            sig = self.hal.signal(args[0])
+        except HalError as exc:
+            raise self.failure("gets", exc) from None
         self.out(value_text(sig.type, sig.value) + "\n")
 
     def cmd_stype(self, args: list[str]) -> None:
-        sig = self._signal(args[0])
+        try:
+            sig = self.hal.signal(args[0])
+        except HalError as exc:
+            raise self.failure("gets", exc) from None
         self.out(type_name(sig.type) + "\n")
 
     # ------------------------------------------------------------ values
 
     def cmd_setp(self, args: list[str], name: str = "setp") -> None:
-        item = find("param", args[0]) or find("pin", args[0])
-        if item is None:
-            raise CommandError(f"parameter or pin '{args[0]}' not found")
-        if isinstance(item, _core.Param):
-            if item.direction == _core.RO:
-                raise CommandError(f"param '{args[0]}' is not writable")
-        else:
-            if item.direction == _core.OUT:
-                raise CommandError(f"pin '{args[0]}' is not writable")
-            if item.signal is not None:
-                raise CommandError(f"pin '{args[0]}' is connected to a "
-                                   "signal")
         try:
-            value = parse_value(item.type, args[1])
-        except ValueError:
-            raise CommandError(
-                f"value '{args[1]}' invalid for {_value_word(item.type)}",
-                "setp failed") from None
-        item.write(value)
+            # the reference's setp ignores locks
+            self.hal.setp(args[0], args[1], ignore_lock=True, wrap=True)
+        except HalError as exc:
+            raise self._value_failure("setp", exc, "param", args[0],
+                                      args[1]) from None
         self.info(f"setting parameter '{args[0]}' to '{args[1]}'")
-        kind = "Pin" if isinstance(item, _core.Pin) else "Parameter"
+        kind = "Pin" if self.hal.find("param", args[0]) is None \
+            else "Parameter"
         self.info(f"{kind} '{args[0]}' set to {args[1]}")
+
+    def _value_failure(self, command: str, exc: HalError, kind: str,
+                       name: str, text: str) -> CommandError:
+        if exc.rule != Rule.BAD_VALUE:
+            return self.failure(command, exc)
+        item = self.hal.find(kind, name) or self.hal.find("pin", name)
+        return self.failure(command, exc, value=text,
+                            type_word=HalType(item.type).value_word)
 
     def cmd_getp(self, args: list[str]) -> None:
         item = self._item(args[0])
@@ -598,28 +556,11 @@ class Executor:
     # ------------------------------------------------------------ links
 
     def _link(self, pin_name: str, sig_name: str, what: str) -> None:
-        if self._locked(LOCK_CONFIG):
-            raise hal_error("link called while HAL locked",
-                            f"{what} failed")
-        pin = find("pin", pin_name)
-        if pin is None:
-            raise hal_error(f"pin '{pin_name}' not found", f"{what} failed")
-        sig = _core.find("signal", sig_name)
-        if sig is None:
-            raise hal_error(f"signal '{sig_name}' not found",
-                            f"{what} failed")
-        if pin.type != sig.type:
-            raise hal_error(f"type mismatch '{pin_name}' <- '{sig_name}'",
-                            f"{what} failed")
-        current = pin.signal
-        if current is not None:
-            raise hal_error(f"pin '{pin.name}' is linked to '{current.name}'"
-                            f", cannot link to '{sig_name}'", f"{what} failed")
-        if pin.direction in (_core.OUT, _core.IO) and \
-                (sig.writers or sig.bidirs and pin.direction == _core.OUT):
-            raise hal_error(f"signal '{sig_name}' already has output or "
-                            "I/O pin(s)", f"{what} failed")
-        _core.link(pin.name, sig_name)
+        try:
+            self.hal.linkps(pin_name, sig_name)
+        except HalError as exc:
+            raise self.failure("link", exc, exc.kind,
+                               failed=f"{what} failed") from None
 
     def cmd_linkps(self, args: list[str]) -> None:
         self._link(args[0], args[1], "link")
@@ -632,97 +573,63 @@ class Executor:
             self._linkpp_warned = True
             self.error("Warning: linkpp command is deprecated, use 'net'")
         first, second = args
-        pin = find("pin", first)
+        pin = self.hal.find("pin", first)
         if pin is None:
             raise CommandError(f"pin '{first}' not found")
-        other = find("pin", second)
+        other = self.hal.find("pin", second)
         if other is None:
             raise CommandError(f"pin '{second}' not found")
         if other.type != pin.type:
             raise CommandError(f"pins '{first}' and '{second}' not of the "
                                "same type")
-        if _core.find("signal", first) is None:
-            _core.signal_new(first, pin.type)
+        if self.hal.find("signal", first) is None:
+            self.hal.newsig(first, pin.type)
             self.created("signal", [first])
         self._link(first, first, "linkpp")
         self._link(second, first, "linkpp")
 
     def cmd_unlinkp(self, args: list[str]) -> None:
-        if self._locked(LOCK_CONFIG):
-            raise hal_error("unlink called while HAL locked",
-                            "unlink failed")
-        pin = find("pin", args[0])
-        if pin is None:
-            raise hal_error(f"pin '{args[0]}' not found", "unlink failed")
-        _core.unlink(pin.name)
+        try:
+            self.hal.unlinkp(args[0])
+        except HalError as exc:
+            raise self.failure("unlinkp", exc) from None
 
     def cmd_net(self, args: list[str]) -> None:
         signame = args[0]
         pins = [a for a in args[1:] if a not in ARROWS]
-        if find("pin", signame) is not None:
-            raise CommandError(f"Signal name '{signame}' must not be the "
-                               "same as a pin.  Did you omit the signal "
-                               "name?")
-        if not pins:
-            raise CommandError("'net' requires at least one pin, none given")
-        sig = _core.find("signal", signame)
-        handles = []
-        for name in pins:
-            pin = find("pin", name)
-            if pin is None:
-                raise CommandError(f"Pin '{name}' does not exist")
-            if pin.signal is not None and pin.signal.name != signame:
-                raise CommandError(f"Pin '{name}' was already linked to "
-                                   f"signal '{pin.signal.name}'")
-            if sig is not None and sig.type != pin.type:
-                raise CommandError(
-                    f"Signal '{signame}' of type '{type_name(sig.type)}' "
-                    f"cannot add pin '{name}' of type "
-                    f"'{type_name(pin.type)}'")
-            if sig is not None and pin.signal is None:
-                self._check_writer(sig, pin)
-            handles.append(pin)
-        stype = sig.type if sig is not None else handles[0].type
-        for pin in handles:
-            if pin.type != stype:
-                raise hal_error(f"type mismatch '{pin.name}' <- "
-                                f"'{signame}'", "link failed")
-        writers = sig.writers if sig is not None else 0
-        bidirs = sig.bidirs if sig is not None else 0
-        for pin in handles:
-            if pin.signal is not None:
-                continue
-            if pin.direction == _core.OUT and (writers or bidirs) or \
-                    pin.direction == _core.IO and writers:
-                raise hal_error(f"signal '{signame}' already has output or "
-                                "I/O pin(s)", "link failed")
-            writers += pin.direction == _core.OUT
-            bidirs += pin.direction == _core.IO
-        if self._locked(LOCK_CONFIG):
-            raise hal_error("signal_new called while HAL is locked") \
-                if sig is None else \
-                hal_error("link called while HAL locked", "link failed")
-        if sig is None:
-            _core.signal_new(signame, stype)
+        existed = self.hal.find("signal", signame) is not None
+        handles = [self.hal.find("pin", name) for name in pins]
+        new = [p for p in handles if p is not None and p.signal is None]
+        try:
+            self.hal.net(signame, *pins)
+        except HalError as exc:
+            raise self._net_failure(exc, existed) from None
+        if not existed:
             self.created("signal", [signame])
-        for pin in handles:
-            if pin.signal is None:
-                _core.link(pin.name, signame)
-                self.info(f"Pin '{pin.name}' linked to signal '{signame}'")
+        for pin in new:
+            self.info(f"Pin '{pin.name}' linked to signal '{signame}'")
 
-    def _check_writer(self, sig, pin) -> None:
-        """The reference's check for a pin joining an existing signal."""
-        if pin.direction not in (_core.OUT, _core.IO):
-            return
-        for other in sorted(sig.pins, key=lambda p: p.name.encode()):
-            if other.direction == _core.OUT or (
-                    other.direction == _core.IO and
-                    pin.direction == _core.OUT):
-                raise CommandError(
-                    f"Signal '{sig.name}' can not add "
-                    f"{_core.DIR_NAMES[pin.direction]} pin '{pin.name}', "
-                    f"it already has {_core.DIR_NAMES[other.direction]} "
-                    f"pin '{other.name}'")
+    def _net_failure(self, exc: HalError, existed: bool) -> CommandError:
+        """The reference's words for a refused ``net``: they depend on
+        whether the signal existed and whether the pin the new one
+        conflicts with was on it already (nothing changed: it still is)."""
+        if exc.rule == Rule.TYPE_MISMATCH:
+            sig = self.hal.find("signal", exc.names[0])
+            pin = self.hal.find("pin", exc.names[1])
+            return self.failure(
+                "net", exc, "existing" if existed else "new",
+                sig_type=type_name(sig.type) if sig else "",
+                pin_type=type_name(pin.type) if pin else "")
+        if exc.rule in (Rule.SECOND_WRITER, Rule.WRITER_AND_IO):
+            pin = self.hal.find("pin", exc.names[1])
+            other = self.hal.find("pin", exc.names[2]) \
+                if len(exc.names) > 2 else None
+            if other is None or other.signal is None:
+                return self.failure("net", exc, "new")
+            return self.failure("net", exc, "existing",
+                                pin_dir=Direction(pin.direction).word,
+                                other_dir=Direction(other.direction).word)
+        return self.failure("net", exc, exc.kind)
 
     # ------------------------------------------------------------ threads
 
@@ -733,25 +640,12 @@ class Executor:
             position = _atoi(args[2])
             if position == 0:
                 raise hal_error("bad position: 0", "addf failed")
-        if self._locked(LOCK_CONFIG):
-            raise hal_error("add_funct_to_thread called while HAL is "
-                            "locked", "addf failed")
-        if _core.find("function", funct) is None:
-            raise hal_error(f"function '{funct}' not found", "addf failed")
-        handle = _core.find("thread", thread)
-        if handle is None:
-            raise hal_error(f"thread '{thread}' not found", "addf failed")
-        n = len(handle.functions)
-        if position > n + 1:
-            raise hal_error(f"position '{position}' is too high",
-                            "addf failed")
-        if position < -(n + 1):
-            raise hal_error(f"position '{position}' is too low",
-                            "addf failed")
         try:
             self.hal.addf(funct, thread, position)
         except HalError as exc:
-            raise hal_error(str(exc), "addf failed") from None
+            raise self.failure("addf", exc, exc.kind, position=position,
+                               high_low="high" if position > 0 else "low"
+                               ) from None
         self.info(f"Function '{funct}' added to thread '{thread}'")
 
     def cmd_delf(self, args: list[str]) -> None:
@@ -760,31 +654,22 @@ class Executor:
         if len(args) < 2:
             raise hal_error("missing thread name", "delf failed")
         funct, thread = args
-        if self._locked(LOCK_CONFIG):
-            raise hal_error("del_funct_from_thread called while HAL is "
-                            "locked", "delf failed")
-        handle = _core.find("function", funct)
-        if handle is None:
-            raise hal_error(f"function '{funct}' not found", "delf failed")
-        if handle.users == 0:
-            raise hal_error(f"function '{funct}' is not in use",
-                            "delf failed")
-        if _core.find("thread", thread) is None:
-            raise hal_error(f"thread '{thread}' not found", "delf failed")
         try:
             self.hal.delf(funct, thread)
         except HalError as exc:
-            raise hal_error(str(exc), "delf failed") from None
+            raise self.failure("delf", exc, exc.kind) from None
 
     def cmd_start(self, args: list[str]) -> None:
-        if self._locked(LOCK_RUN):
-            raise hal_error("start_threads called while HAL is locked")
-        self.hal.start()
+        try:
+            self.hal.start()
+        except HalError as exc:
+            raise self.failure("start", exc) from None
 
     def cmd_stop(self, args: list[str]) -> None:
-        if self._locked(LOCK_RUN):
-            raise hal_error("stop_threads called while HAL is locked")
-        self.hal.stop()
+        try:
+            self.hal.stop()
+        except HalError as exc:
+            raise self.failure("stop", exc) from None
 
     # ------------------------------------------------------------ aliases
 
@@ -792,19 +677,10 @@ class Executor:
         kind, name, alias = args
         if kind not in ("pin", "param"):
             raise CommandError("alias failed")
-        if self._locked(LOCK_CONFIG):
-            raise hal_error(f"{kind}_alias called while HAL locked",
-                            "alias failed")
-        item = find(kind, name)
-        if item is None:
-            raise hal_error(f"{kind} '{name}' not found", "alias failed")
-        if find("pin", alias) is not None or find("param", alias) is not None:
-            raise hal_error(f"duplicate pin/alias name '{alias}'",
-                            "alias failed")
         try:
-            _core.alias(kind, item.name, alias)
+            self.hal.alias(kind, name, alias)
         except HalError as exc:
-            raise hal_error(str(exc), "alias failed") from None
+            raise self.failure("alias", exc) from None
         self.created(kind, [alias])
         self.info(f"{kind} '{name}' aliased to '{alias}'")
 
@@ -812,22 +688,22 @@ class Executor:
         kind, alias = args
         if kind not in ("pin", "param"):
             return              # the reference ignores other kinds
-        item = _core.find(kind, alias)
-        if item is None or item.alias_of is None:
-            raise hal_error(f"{kind} '{alias}' not found", "unalias failed")
-        _core.unalias(kind, alias)
+        try:
+            self.hal.unalias(kind, alias)
+        except HalError as exc:
+            raise self.failure("unalias", exc) from None
 
     # ------------------------------------------------------------ locks
 
     def cmd_lock(self, args: list[str]) -> None:
         word = args[0] if args else "all"
         if word in LOCK_WORDS:
-            _core.set_lock(_core.get_lock() | LOCK_WORDS[word])
+            self.hal.lock_level |= LOCK_WORDS[word]
 
     def cmd_unlock(self, args: list[str]) -> None:
         word = args[0] if args else "all"
         if word in LOCK_WORDS:
-            _core.set_lock(_core.get_lock() & ~LOCK_WORDS[word] & 255)
+            self.hal.lock_level &= ~LOCK_WORDS[word] & 255
 
     # ------------------------------------------------------------ output
 
@@ -843,11 +719,11 @@ class Executor:
     def cmd_save(self, args: list[str]) -> None:
         what = args[0] if args else "all"
         if len(args) < 2:
-            if not Saver(self.out, self.hal.loadrt_args()).save(what):
+            if not Saver(self.hal, self.out, self.hal.loadrt_args()).save(what):
                 raise CommandError(f"Unknown 'save' type '{what}'")
             return
         lines: list[str] = []
-        if not Saver(lines.append, self.hal.loadrt_args()).save(what):
+        if not Saver(self.hal, lines.append, self.hal.loadrt_args()).save(what):
             raise CommandError(f"Unknown 'save' type '{what}'")
         try:
             with open(args[1], "w", encoding="utf-8") as f:
@@ -858,7 +734,7 @@ class Executor:
 
     def cmd_status(self, args: list[str]) -> None:
         what = args[0] if args else "all"
-        if not status(self.out, what):
+        if not status(self.hal, self.out, what):
             raise CommandError(f"Unknown 'status' type '{what}'")
 
     def cmd_help(self, args: list[str]) -> None:
@@ -876,7 +752,7 @@ class Executor:
 
     def cmd_debug(self, args: list[str]) -> None:
         level = _atoi(args[0])
-        _core.set_msg_level(max(0, min(5, level)))
+        self.hal.msg_level = max(0, min(5, level))
 
     def cmd_print(self, args: list[str]) -> None:
         text = " ".join(args) if args else "(null)"
@@ -905,10 +781,6 @@ class Executor:
         raise Quit()
 
     cmd_exit = cmd_quit
-
-
-def _value_word(t: int) -> str:
-    return _TYPE_WORD.get(t, "?")
 
 
 def _atoi(text: str) -> int:

@@ -5,16 +5,18 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import Callable
 
-from halsdk.core import _core
 from halsdk.halcmd.show import sorted_items, threads, type_name, value_cell
+from halsdk.types import Direction
 
 Out = Callable[[str], None]
 
 SAVE_ALL = ("comp", "alias", "sigu", "netla", "param", "thread")
 SAVE_ALLU = ("comp", "alias", "sigu", "netla", "param",
              "unconnectedinpins", "thread")
-_PIN_ARROW = {_core.IN: "<==", _core.OUT: "==>", _core.IO: "<=>"}
-_SIG_ARROW = {_core.IN: "==>", _core.OUT: "<==", _core.IO: "<=>"}
+_PIN_ARROW = {Direction.IN: "<==", Direction.OUT: "==>",
+              Direction.IO: "<=>"}
+_SIG_ARROW = {Direction.IN: "==>", Direction.OUT: "<==",
+              Direction.IO: "<=>"}
 _LOCK_LINES = (
     (1, "  HAL_LOCK_LOAD    - loading of new components is locked"),
     (2, "  HAL_LOCK_CONFIG  - link and addf is locked"),
@@ -32,7 +34,8 @@ class Saver:
     """Writes ``save`` output; ``loadrt_args`` maps component names to the
     words of the ``loadrt`` line that made them."""
 
-    def __init__(self, out: Out, loadrt_args: Mapping[str, str]):
+    def __init__(self, hal, out: Out, loadrt_args: Mapping[str, str]):
+        self.hal = hal
         self.out = out
         self.loadrt_args = loadrt_args
 
@@ -68,7 +71,7 @@ class Saver:
 
     def comps(self) -> None:
         self.out("# components\n")
-        comps = sorted((c for c in _core.items("component") if c.realtime),
+        comps = sorted((c for c in self.hal.items("component") if c.realtime),
                        key=lambda c: c.id)
         for c in comps:
             args = self.loadrt_args.get(c.name)
@@ -81,21 +84,21 @@ class Saver:
     def aliases(self) -> None:
         for kind, title in (("pin", "pin"), ("param", "param")):
             self.out(f"# {title} aliases\n")
-            for it in sorted_items(kind):
+            for it in sorted_items(self.hal, kind):
                 if it.alias_of is not None:
                     self.out(f"alias {kind} {it.alias_of} {it.name}\n")
 
     def signals(self, unlinked_only: bool) -> None:
         self.out("# signals\n")
-        pins = sorted_items("pin") if unlinked_only else []
-        for sig in sorted_items("signal"):
+        pins = sorted_items(self.hal, "pin") if unlinked_only else []
+        for sig in sorted_items(self.hal, "signal"):
             if unlinked_only and _linked(pins, sig.name):
                 continue
             self.out(f"newsig {sig.name} {type_name(sig.type):<5}\n")
 
     def links(self, arrows: bool) -> None:
         self.out("# links\n")
-        for pin in sorted_items("pin"):
+        for pin in sorted_items(self.hal, "pin"):
             sig = pin.signal
             if sig is not None:
                 arrow = _PIN_ARROW[pin.direction] if arrows else ""
@@ -103,8 +106,8 @@ class Saver:
 
     def nets(self, arrows: bool) -> None:
         self.out("# nets\n")
-        pins = sorted_items("pin")
-        for sig in sorted_items("signal"):
+        pins = sorted_items(self.hal, "pin")
+        for sig in sorted_items(self.hal, "signal"):
             self.out(f"newsig {sig.name} {type_name(sig.type):<5}\n")
             for pin in _linked(pins, sig.name):
                 arrow = _SIG_ARROW[pin.direction] if arrows else ""
@@ -112,8 +115,8 @@ class Saver:
 
     def netl(self, arrows: bool) -> None:
         self.out("# nets\n")
-        pins = sorted_items("pin")
-        for sig in sorted_items("signal"):
+        pins = sorted_items(self.hal, "pin")
+        for sig in sorted_items(self.hal, "signal"):
             linked = _linked(pins, sig.name)
             if not linked:
                 continue
@@ -121,41 +124,41 @@ class Saver:
                 words = [p.name for p in linked]
             else:
                 writers = [p.name for p in linked
-                           if p.direction == _core.OUT]
+                           if p.direction == Direction.OUT]
                 others = [p.name for p in linked
-                          if p.direction != _core.OUT]
+                          if p.direction != Direction.OUT]
                 words = writers + (["=>"] if writers and others else []) \
                     + others
             self.out(f"net {sig.name} {' '.join(words)}\n")
 
     def params(self) -> None:
         self.out("# parameter values\n")
-        for par in sorted_items("param"):
-            if par.direction != _core.RO:
+        for par in sorted_items(self.hal, "param"):
+            if par.direction != Direction.RO:
                 self.out(f"setp {par.name} "
                          f"{value_cell(par.type, par.value)}\n")
 
     def threads(self) -> None:
         self.out("# realtime thread/function links\n")
-        for t in threads():
+        for t in threads(self.hal):
             for f in t.functions:
                 self.out(f"addf {f} {t.name}\n")
 
     def unconnected(self) -> None:
         self.out("# unconnected pin values\n")
-        for pin in sorted_items("pin"):
+        for pin in sorted_items(self.hal, "pin"):
             # I/O pins are inputs too (the IN bit is set in IO)
-            if pin.direction & _core.IN and pin.signal is None:
+            if pin.direction & Direction.IN and pin.signal is None:
                 self.out(f"setp {pin.name} "
                          f"{value_cell(pin.type, pin.value)}\n")
 
 
-def status(out: Out, what: str) -> bool:
+def status(hal, out: Out, what: str) -> bool:
     """``status [lock|mem|all]``; False for an unknown word."""
     if what not in ("", "all", "lock", "mem"):
         return False
     if what in ("", "all", "lock"):
-        level = _core.get_lock()
+        level = hal.lock_level
         out("HAL locking status:\n")
         out(f"  current lock value {level} ({level:02x})\n")
         if level == 0:
@@ -164,7 +167,7 @@ def status(out: Out, what: str) -> bool:
             if level & bit:
                 out(line + "\n")
     if what in ("", "all", "mem"):
-        info = _core.info()
+        info = hal.info()
         counts = info["counts"]
         used = info["heap_top"]
         out("HAL memory status\n")
@@ -173,7 +176,7 @@ def status(out: Out, what: str) -> bool:
                           ("parameters", "param")):
             out(f"  active/recycled {word + ':':<11} {counts[key]}/0\n")
         aliases = sum(1 for kind in ("pin", "param")
-                      for it in _core.items(kind) if it.alias_of is not None)
+                      for it in hal.items(kind) if it.alias_of is not None)
         out(f"  active/recycled aliases:    {aliases}/0\n")
         for word, key in (("signals", "signal"), ("functions", "function"),
                           ("threads", "thread")):

@@ -13,36 +13,38 @@ import os
 from collections.abc import Sequence
 from typing import Any, Callable
 
-from halsdk.core import _core
+from halsdk.types import DIR_WORDS, HalType, dir_word
+from halsdk.types import type_word as _type_word
 
 Out = Callable[[str], None]
 NAME_LEN = 47
-_ARROW_PIN = {_core.IN: "<==", _core.OUT: "==>", _core.IO: "<=>"}
-_ARROW_SIG = {_core.IN: "==>", _core.OUT: "<==", _core.IO: "<=>"}
+_IN, _OUT, _IO = (d for d in DIR_WORDS if d.word in ("IN", "OUT", "I/O"))
+_ARROW_PIN = {_IN: "<==", _OUT: "==>", _IO: "<=>"}
+_ARROW_SIG = {_IN: "==>", _OUT: "<==", _IO: "<=>"}
 
 
 def type_name(t: int) -> str:
-    return _core.TYPE_NAMES.get(t, "???")
+    return _type_word(t)
 
 
 def value_text(t: int, v: Any) -> str:
     """A value as ``getp``/``gets`` print it."""
-    if t == _core.BIT:
+    if t == HalType.BIT:
         return "TRUE" if v else "FALSE"
-    if t == _core.FLOAT:
+    if t == HalType.FLOAT:
         return f"{v:.7g}"
     return f"{v:d}"
 
 
 def value_cell(t: int, v: Any) -> str:
     """A value as the 12-character column of ``show``."""
-    if t == _core.BIT:
+    if t == HalType.BIT:
         return f"{'TRUE' if v else 'FALSE':>12}"
-    if t == _core.FLOAT:
+    if t == HalType.FLOAT:
         return f"{v:12.7g}"
-    if t == _core.U32:
+    if t == HalType.U32:
         return f"  0x{v:08X}"
-    if t == _core.U64:
+    if t == HalType.U64:
         return f"0x{v:016X}"
     return f"  {v:10d}"
 
@@ -55,24 +57,25 @@ def match(patterns: Sequence[str], name: str) -> bool:
                for p in patterns)
 
 
-def sorted_items(kind: str) -> list:
-    return sorted((it for it in _core.items(kind) if it.exists),
+def sorted_items(hal, kind: str) -> list:
+    return sorted((it for it in hal.items(kind) if it.exists),
                   key=lambda it: it.name.encode())
 
 
-def components() -> list:
+def components(hal) -> list:
     """Components newest first (the reference's list order)."""
-    return sorted(_core.items("component"), key=lambda c: -c.id)
+    return sorted(hal.items("component"), key=lambda c: -c.id)
 
 
-def threads() -> list:
-    return list(reversed(_core.items("thread")))
+def threads(hal) -> list:
+    return list(reversed(hal.items("thread")))
 
 
 class Shower:
     """Prints HAL items; ``script`` selects the ``-s`` formats."""
 
-    def __init__(self, out: Out, script: bool = False):
+    def __init__(self, hal, out: Out, script: bool = False):
+        self.hal = hal
         self.out = out
         self.script = script
 
@@ -93,7 +96,7 @@ class Shower:
             self.out("Loaded HAL Components:\n")
             self.out("ID      Type  Name                                  "
                      "          PID   State\n")
-        for c in components():
+        for c in components(self.hal):
             if not match(patterns, c.name):
                 continue
             kind = "RT" if c.realtime else "User"
@@ -104,11 +107,11 @@ class Shower:
         self.out("\n")
 
     def _values(self, kind: str, patterns: Sequence[str]) -> None:
-        for it in sorted_items(kind):
+        for it in sorted_items(self.hal, kind):
             if not match(patterns, it.name):
                 continue
             tname = type_name(it.type)
-            dname = _core.DIR_NAMES.get(it.direction, "???")
+            dname = dir_word(it.direction)
             cell = self.cell(it.type, it.value)
             if not self.script:
                 line = (f" {it.owner_id:5d}  {tname:<5} {dname:<3}  {cell}"
@@ -139,7 +142,7 @@ class Shower:
         if not self.script:
             self.out("Signals:\n")
             self.out("Type          Value  Name     (linked to)\n")
-        for sig in sorted_items("signal"):
+        for sig in sorted_items(self.hal, "signal"):
             if not match(patterns, sig.name):
                 continue
             linked = sorted(sig.pins, key=lambda p: p.name.encode())
@@ -159,7 +162,7 @@ class Shower:
         if not self.script:
             self.out("Exported Functions:\n")
             self.out("Owner   CodeAddr  Arg       FP   Users  Name\n")
-        for n, f in enumerate(sorted_items("function")):
+        for n, f in enumerate(sorted_items(self.hal, "function")):
             if not match(patterns, f.name):
                 continue
             code, arg = fake_addresses(f.owner_id, n)
@@ -177,13 +180,13 @@ class Shower:
             self.out("Realtime Threads:\n")
             self.out("     Period  FP     Name               "
                      "(     Time, Max-Time )\n")
-        for t in threads():
+        for t in threads(self.hal):
             if not match(patterns, t.name):
                 continue
             fp = "YES" if t.uses_fp else "NO"
             functs = t.functions
-            time_pin = _core.find("pin", t.name + ".time")
-            tmax_par = _core.find("param", t.name + ".tmax")
+            time_pin = self.hal.find("pin", t.name + ".time")
+            tmax_par = self.hal.find("param", t.name + ".tmax")
             now = time_pin.value if time_pin is not None else t.time
             tmax = tmax_par.value if tmax_par is not None else t.tmax
             if self.script:
@@ -202,7 +205,7 @@ class Shower:
                      else "Parameter Aliases:\n")
             self.out(" Alias                                            "
                      "Original Name\n")
-        for it in sorted_items(kind):
+        for it in sorted_items(self.hal, kind):
             orig = it.alias_of
             if orig is None or not match(patterns, it.name):
                 continue
@@ -247,17 +250,17 @@ class Shower:
     def names(self, what: str, patterns: Sequence[str]) -> bool:
         """Print one ``list`` line; False for an unknown item word."""
         if what == "comp":
-            names = [c.name for c in components()]
+            names = [c.name for c in components(self.hal)]
         elif what == "pin":
-            names = [p.name for p in sorted_items("pin")]
+            names = [p.name for p in sorted_items(self.hal, "pin")]
         elif what in ("sig", "signal"):
-            names = [s.name for s in sorted_items("signal")]
+            names = [s.name for s in sorted_items(self.hal, "signal")]
         elif what in ("param", "parameter"):
-            names = [p.name for p in sorted_items("param")]
+            names = [p.name for p in sorted_items(self.hal, "param")]
         elif what in ("funct", "function"):
-            names = [f.name for f in sorted_items("function")]
+            names = [f.name for f in sorted_items(self.hal, "function")]
         elif what == "thread":
-            names = [t.name for t in threads()]
+            names = [t.name for t in threads(self.hal)]
         else:
             return False
         self.out("".join(n + " " for n in names if match(patterns, n))

@@ -35,7 +35,7 @@ from __future__ import annotations
 import os
 from typing import Optional
 
-from halsdk.halcmd.commands import Executor
+from halsdk.halcmd.commands import CommandRunner
 from halsdk.halcmd.lexer import (
     IniFile,
     SubstitutionError,
@@ -132,7 +132,7 @@ def _int(text: str) -> int:
 class Twopass:
     """Runs the ``[HAL]HALFILE`` files of an INI file in two passes."""
 
-    def __init__(self, ex: Executor, ini_path: str):
+    def __init__(self, ex: CommandRunner, ini_path: str):
         self.ex = ex
         self.ini_path = ini_path
         options = " ".join(ini_values(ini_path, "HAL", "TWOPASS")).lower()
@@ -291,7 +291,7 @@ class Twopass:
             raise TwopassError("twopass: loading the modules failed")
 
 
-def run(ex: Executor, ini_path: str) -> int:
+def run(ex: CommandRunner, ini_path: str) -> int:
     """Twopass-load the ``[HAL]HALFILE`` files of ``ini_path`` with the
     executor ``ex``; returns the exit status (0 or 1)."""
     return Twopass(ex, ini_path).run()

@@ -108,8 +108,8 @@ class Launcher:
             raise
 
     def _executor(self, hal: Any = None) -> Any:
-        from halsdk.halcmd.commands import Executor
-        ex = Executor(hal or self.hal, ini=self.ini.path, register=False,
+        from halsdk.halcmd.commands import CommandRunner
+        ex = CommandRunner(hal or self.hal, ini=self.ini.path, register=False,
                       workdir=self.workdir)
         self._executors.append(ex)
         return ex
@@ -149,9 +149,8 @@ class Launcher:
                               "message above)")
 
     def _configure_motion(self) -> None:
-        from halsdk.core import _core
         try:
-            _core.shmem_attach("motmod.channel")
+            self.hal.shared_block("motmod.channel")
         except HalError:
             return                      # no motion module: a plain HAL
         from halsdk.motion import Motion

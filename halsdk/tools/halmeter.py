@@ -139,26 +139,25 @@ def parse_args(argv: Sequence[str]) -> Options:
 
 def format_value(hal_type: int, value: Any) -> str:
     """The value as the reference meter displays it."""
-    from halsdk.core import _core
-    if hal_type == _core.BIT:
+    from halsdk.types import HalType
+    if hal_type == HalType.BIT:
         return "TRUE" if value else "FALSE"
-    if hal_type == _core.FLOAT:
+    if hal_type == HalType.FLOAT:
         v = float(value)
         if v != v:                      # C prints the sign of a NaN
             return "-nan" if math.copysign(1.0, v) < 0 else "nan"
         return f"{v:.7g}"
-    if hal_type in (_core.S32, _core.S64):
+    if hal_type in (HalType.S32, HalType.S64):
         return f"{int(value):10d}"
-    if hal_type in (_core.U32, _core.U64):
+    if hal_type in (HalType.U32, HalType.U64):
         n = int(value)
         return f"{n:10d} (0x{n:08X})"
     raise ValueError(f"unknown HAL type {hal_type}")
 
 
-def _find(kind: str, name: str):
+def _find(hal, kind: str, name: str):
     """The handle of the watched item, or None."""
-    from halsdk.core import _core
-    return _core.find(_KINDS[kind], name)
+    return hal.find(_KINDS[kind], name)
 
 
 def meter(item, out, count: int, period_s: float, stop: list) -> int:
@@ -215,7 +214,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         return 1
     what = _KINDS[opts.kind]
     try:
-        item = _find(opts.kind, opts.name)
+        item = _find(hal, opts.kind, opts.name)
         if item is None:
             print(f"{PROG}: ERROR: {what} '{opts.name}' not found",
                   file=sys.stderr)

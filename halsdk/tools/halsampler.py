@@ -81,9 +81,9 @@ def copy_records(stream, out: IO[str], count: int, tag: bool,
                  stop: list) -> int:
     """Copy records to ``out`` until ``count`` were printed (forever when
     negative) or ``stop`` becomes non-empty; returns the number printed."""
-    from halsdk.core import _core
+    from halsdk.types import HalType
     types = stream.types
-    floats = [t == _core.FLOAT for t in types]
+    floats = [t == HalType.FLOAT for t in types]
     names = [f"v{i}" for i in range(len(types))]
     last = -1
     done = 0
@@ -128,7 +128,6 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     stop = stop_on_signals()
 
     from halsdk import errors
-    from halsdk.core import _core
     hal = attach(PROG)
     if hal is None:
         return 1
@@ -136,7 +135,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     out: IO[str]
     try:
         try:
-            stream = _core.stream_attach(name)
+            stream = hal.stream(name)
         except errors.NotFoundError:
             print(f"{PROG}: ERROR: stream '{name}' not found (is 'loadrt "
                   f"sampler' loaded with at least {chan + 1} channel"

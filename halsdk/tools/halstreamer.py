@@ -81,7 +81,7 @@ def _c_unsigned(tok: str, bits: int) -> int:
 def parse_line(line: str, types: Sequence[int]) -> list:
     """Values of one input line for a channel of ``types``; raises
     :class:`LineError` the way the reference rejects a line."""
-    from halsdk.core import _core
+    from halsdk.types import HalType
     values = []
     pos, end = 0, len(line)
     for i, t in enumerate(types):
@@ -94,13 +94,13 @@ def parse_line(line: str, types: Sequence[int]) -> list:
             stop += 1
         tok = line[pos:stop]
         pos = stop
-        if t == _core.FLOAT:
+        if t == HalType.FLOAT:
             v = parse_float(tok)
             if v is None:
                 raise LineError(i, "bad character")
             values.append(v)
             continue
-        if t == _core.BIT:
+        if t == HalType.BIT:
             if tok[0] not in "01":
                 raise LineError(i, "bit value not 0 or 1")
             if len(tok) > 1:
@@ -109,11 +109,11 @@ def parse_line(line: str, types: Sequence[int]) -> list:
             continue
         if not _INT.match(tok):
             raise LineError(i, "bad character")
-        if t == _core.S32:
+        if t == HalType.S32:
             values.append(_c_signed(tok, 32))
-        elif t == _core.U32:
+        elif t == HalType.U32:
             values.append(_c_unsigned(tok, 32))
-        elif t == _core.S64:
+        elif t == HalType.S64:
             values.append(_c_signed(tok, 64))
         else:
             values.append(_c_unsigned(tok, 64))
@@ -192,14 +192,13 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     stop = stop_on_signals()
 
     from halsdk import errors
-    from halsdk.core import _core
     hal = attach(PROG)
     if hal is None:
         return 1
     name = f"streamer.{chan}"
     try:
         try:
-            stream = _core.stream_attach(name)
+            stream = hal.stream(name)
         except errors.NotFoundError:
             print(f"{PROG}: ERROR: stream '{name}' not found (is 'loadrt "
                   f"streamer' loaded with at least {chan + 1} channel"

@@ -25,22 +25,6 @@
 #include <unistd.h>
 
 hal_map_t hal_map;
-static __thread char errbuf[512];
-static int cur_owner;           /* last comp/inst created here: hal_malloc */
-
-int hal_fail(int err, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(errbuf, sizeof(errbuf), fmt, ap);
-    va_end(ap);
-    return err > 0 ? -err : err;
-}
-
-const char *hal_last_error(void)
-{
-    return errbuf;
-}
 
 static const char *kind_word(int kind)
 {
@@ -50,6 +34,75 @@ static const char *kind_word(int kind)
     };
     return kind > 0 && kind < K_NKINDS ? words[kind] : "object";
 }
+
+static __thread char errbuf[512];
+static __thread int err_rule, err_kind;
+static __thread char err_names[3][HAL_NAME_SIZE];
+static int cur_owner;           /* last comp/inst created here: hal_malloc */
+
+int hal_fail(int err, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(errbuf, sizeof(errbuf), fmt, ap);
+    va_end(ap);
+    err_rule = HAL_RULE_NONE;
+    err_kind = K_NONE;
+    err_names[0][0] = err_names[1][0] = err_names[2][0] = 0;
+    return err > 0 ? -err : err;
+}
+
+int hal_rule(int r, int rule, int kind, const char *name0,
+             const char *name1, const char *name2)
+{
+    const char *names[3] = {name0, name1, name2};
+    err_rule = rule;
+    err_kind = kind;
+    for (int k = 0; k < 3; k++)
+        snprintf(err_names[k], HAL_NAME_SIZE, "%s", names[k] ? names[k] : "");
+    return r;
+}
+
+const char *hal_last_error(void)
+{
+    return errbuf;
+}
+
+int hal_last_rule(void)
+{
+    return err_rule;
+}
+
+int hal_last_kind(void)
+{
+    return err_kind;
+}
+
+const char *hal_last_name(int index)
+{
+    return index >= 0 && index < 3 ? err_names[index] : "";
+}
+
+/* the usual failures: an object not found, a lock, a duplicate name */
+static int fail_not_found(int kind, const char *name)
+{
+    return hal_rule(hal_fail(ENOENT, "%s '%s' not found", kind_word(kind),
+                             name),
+                    HAL_RULE_NOT_FOUND, kind, name, NULL, NULL);
+}
+
+static int fail_locked(int kind, const char *name, const char *fmt)
+{
+    return hal_rule(hal_fail(EPERM, fmt, name), HAL_RULE_LOCKED, kind, name,
+                    NULL, NULL);
+}
+
+static int fail_exists(int kind, const char *name, const char *fmt)
+{
+    return hal_rule(hal_fail(EEXIST, fmt, name), HAL_RULE_EXISTS, kind,
+                    name, NULL, NULL);
+}
+
 
 /* ---------------------------------------------------------------- */
 /* process identity                                                 */
@@ -328,7 +381,17 @@ static void index_remove(hal_obj_t *o)
     o->hnext = 0;
 }
 
+static int check_name(const char *name, const char *what);
+
 int hal_check_name(const char *name, const char *what)
+{
+    int r = check_name(name, what);
+    return r ? hal_rule(r, HAL_RULE_BAD_NAME, K_NONE, name ? name : "",
+                        NULL, NULL)
+             : 0;
+}
+
+static int check_name(const char *name, const char *what)
 {
     if (!name || !*name)
         return hal_fail(EINVAL, "%s name is empty", what);
@@ -362,11 +425,12 @@ static void *obj_new(int kind, long size, const char *name)
     hal_header_t *h = hal_map.hdr;
     hal_obj_t *o = hal_alloc(size, 0);
     if (!o) {
-        hal_fail(ENOMEM, "HAL instance is full: cannot create %s '%s' "
-                 "(%llu of %llu bytes used; create the instance with a "
-                 "larger size)", kind_word(kind), name,
-                 (unsigned long long)h->bytes_used,
-                 (unsigned long long)h->size);
+        hal_rule(hal_fail(ENOMEM, "HAL instance is full: cannot create %s "
+                          "'%s' (%llu of %llu bytes used; create the "
+                          "instance with a larger size)", kind_word(kind),
+                          name, (unsigned long long)h->bytes_used,
+                          (unsigned long long)h->size),
+                 HAL_RULE_FULL, kind, name, NULL, NULL);
         return NULL;
     }
     o->kind = (uint16_t)kind;
@@ -463,12 +527,15 @@ static int resolve_owner(int id, hal_comp_t **comp, hal_inst_t **inst,
             *comp = SHMPTR((*inst)->comp);
     }
     if (!*comp)
-        return hal_fail(EINVAL, "%s '%s': no component with id %d", what,
-                        name, id);
+        return hal_rule(hal_fail(EINVAL, "%s '%s': no component with id "
+                                 "%d", what, name, id),
+                        HAL_RULE_BAD_ARG, K_NONE, name, NULL, NULL);
     if ((*comp)->pid != getpid())
-        return hal_fail(EPERM, "%s '%s': component '%s' belongs to "
-                        "process %d", what, name, (*comp)->o.name,
-                        (*comp)->pid);
+        return hal_rule(hal_fail(EPERM, "%s '%s': component '%s' belongs "
+                                 "to process %d", what, name,
+                                 (*comp)->o.name, (*comp)->pid),
+                        HAL_RULE_NOT_OWNER, K_COMP, (*comp)->o.name, name,
+                        NULL);
     if ((*comp)->ready && !*inst)
         return hal_fail(EINVAL, "%s '%s': component '%s' is already "
                         "ready; items are created before hal_ready()",
@@ -516,18 +583,20 @@ int hal_comp_new(const char *name, int kind)
     if (r)
         return r;
     if (kind != HALSDK_COMP_USER && kind != HALSDK_COMP_RT)
-        return hal_fail(EINVAL, "component '%s': bad kind %d", name, kind);
+        return hal_rule(hal_fail(EINVAL, "component '%s': bad kind %d",
+                                 name, kind),
+                        HAL_RULE_BAD_ARG, K_COMP, name, NULL, NULL);
     if ((r = hal_lock()))
         return r;
     hal_header_t *h = hal_map.hdr;
     if (kind == HALSDK_COMP_RT && (h->lock & HAL_LOCK_LOAD)) {
         hal_unlock();
-        return hal_fail(EPERM, "component '%s': HAL is locked against "
-                        "loading", name);
+        return fail_locked(K_COMP, name, "component '%s': HAL is locked "
+                           "against loading");
     }
     if (find_in_space(K_COMP, name)) {
         hal_unlock();
-        return hal_fail(EEXIST, "duplicate component name '%s'", name);
+        return fail_exists(K_COMP, name, "duplicate component name '%s'");
     }
     hal_comp_t *c = obj_new(K_COMP, sizeof(*c), name);
     if (!c) {
@@ -573,10 +642,12 @@ int hal_inst_new(const char *name, int comp_id)
         r = hal_fail(EINVAL, "instance '%s': no component with id %d",
                      name, comp_id);
     else if (c->pid != getpid())
-        r = hal_fail(EPERM, "instance '%s': component '%s' belongs to "
-                     "process %d", name, c->o.name, c->pid);
+        r = hal_rule(hal_fail(EPERM, "instance '%s': component '%s' "
+                              "belongs to process %d", name, c->o.name,
+                              c->pid),
+                     HAL_RULE_NOT_OWNER, K_COMP, c->o.name, name, NULL);
     else if (find_in_space(K_COMP, name))
-        r = hal_fail(EEXIST, "duplicate instance name '%s'", name);
+        r = fail_exists(K_INST, name, "duplicate instance name '%s'");
     if (r) {
         hal_unlock();
         return r;
@@ -676,12 +747,15 @@ static int item_add(int kind, const char *name, int type, int dir,
     if (r)
         return r;
     if (!type_size(type))
-        return hal_fail(EINVAL, "%s '%s': bad type %d", what, name, type);
+        return hal_rule(hal_fail(EINVAL, "%s '%s': bad type %d", what,
+                                 name, type),
+                        HAL_RULE_BAD_ARG, kind, name, NULL, NULL);
     if (kind == K_PIN ? dir != HALSDK_IN && dir != HALSDK_OUT &&
                         dir != HALSDK_IO
                       : dir != HALSDK_RO && dir != HALSDK_RW)
-        return hal_fail(EINVAL, "%s '%s': bad direction %d", what, name,
-                        dir);
+        return hal_rule(hal_fail(EINVAL, "%s '%s': bad direction %d", what,
+                                 name, dir),
+                        HAL_RULE_BAD_ARG, kind, name, NULL, NULL);
     if (!hal_map.hdr)
         return hal_fail(ENODEV, "no HAL instance is attached");
     if (!in_segment(where, kind == K_PIN ? (long)sizeof(void *)
@@ -695,7 +769,7 @@ static int item_add(int kind, const char *name, int type, int dir,
     hal_inst_t *i;
     if (!(r = resolve_owner(owner_id, &c, &i, what, name))) {
         if (find_in_space(K_PIN, name))
-            r = hal_fail(EEXIST, "duplicate pin or param name '%s'", name);
+            r = fail_exists(kind, name, "duplicate pin or param name '%s'");
         else if (!item_make(kind, name, type, dir, c, i, (void *)where))
             r = -ENOMEM;
     }
@@ -743,14 +817,19 @@ int hal_alias(int kind, const char *name, const char *alias)
         return r;
     hal_obj_t *o = hal_find(kind, name);
     hoff_t *oldname = NULL;
+    if (hal_map.hdr->lock & HAL_LOCK_CONFIG) {
+        r = fail_locked(kind, name, "cannot alias '%s': HAL is locked "
+                        "against configuration");
+        goto out;
+    }
     if (!o) {
-        r = hal_fail(ENOENT, "%s '%s' not found", kind_word(kind), name);
+        r = fail_not_found(kind, name);
         goto out;
     }
     oldname = kind == K_PIN ? &((hal_pin_t *)o)->oldname
                             : &((hal_param_t *)o)->oldname;
     if (find_in_space(K_PIN, alias)) {
-        r = hal_fail(EEXIST, "duplicate pin or param name '%s'", alias);
+        r = fail_exists(kind, alias, "duplicate pin or param name '%s'");
         goto out;
     }
     r = rename_item(o, oldname, alias);
@@ -767,17 +846,21 @@ int hal_unalias(int kind, const char *alias)
     hal_obj_t *o = hal_find(kind, alias);
     hoff_t *oldname;
     if (!o) {
-        r = hal_fail(ENOENT, "%s '%s' not found", kind_word(kind), alias);
+        r = fail_not_found(kind, alias);
         goto out;
     }
     oldname = kind == K_PIN ? &((hal_pin_t *)o)->oldname
                             : &((hal_param_t *)o)->oldname;
-    if (!*oldname)
-        goto out;           /* not aliased: nothing to do */
+    if (!*oldname) {
+        /* not an alias: as if there were no such name */
+        r = fail_not_found(kind, alias);
+        goto out;
+    }
     char *orig = SHMPTR(*oldname);
     if (find_in_space(K_PIN, orig)) {
-        r = hal_fail(EEXIST, "cannot unalias '%s': its original name '%s' "
-                     "is in use", alias, orig);
+        r = hal_rule(hal_fail(EEXIST, "cannot unalias '%s': its original "
+                              "name '%s' is in use", alias, orig),
+                     HAL_RULE_EXISTS, kind, orig, alias, NULL);
         goto out;
     }
     index_remove(o);
@@ -795,29 +878,35 @@ out:
 /* ---------------------------------------------------------------- */
 /* signals and links                                                */
 
+/* a new signal record, published; lock held */
+static hal_sig_t *signal_make(const char *name, int type)
+{
+    hal_sig_t *s = obj_new(K_SIG, sizeof(*s), name);
+    if (s) {
+        s->type = (int16_t)type;
+        obj_publish(&s->o);
+    }
+    return s;
+}
+
 int hal_signal_new(const char *name, int type)
 {
     int r = hal_check_name(name, "signal");
     if (r)
         return r;
     if (!type_size(type))
-        return hal_fail(EINVAL, "signal '%s': bad type %d", name, type);
+        return hal_rule(hal_fail(EINVAL, "signal '%s': bad type %d", name,
+                                 type),
+                        HAL_RULE_BAD_ARG, K_SIG, name, NULL, NULL);
     if ((r = hal_lock()))
         return r;
     if (hal_map.hdr->lock & HAL_LOCK_CONFIG)
-        r = hal_fail(EPERM, "signal '%s': HAL is locked against "
-                     "configuration", name);
+        r = fail_locked(K_SIG, name, "signal '%s': HAL is locked against "
+                        "configuration");
     else if (find_in_space(K_SIG, name))
-        r = hal_fail(EEXIST, "duplicate signal name '%s'", name);
-    if (!r) {
-        hal_sig_t *s = obj_new(K_SIG, sizeof(*s), name);
-        if (s) {
-            s->type = (int16_t)type;
-            obj_publish(&s->o);
-        } else {
-            r = -ENOMEM;
-        }
-    }
+        r = fail_exists(K_SIG, name, "duplicate signal name '%s'");
+    else if (!signal_make(name, type))
+        r = -ENOMEM;
     hal_unlock();
     return r;
 }
@@ -856,11 +945,11 @@ int hal_signal_delete(const char *name)
     if (r)
         return r;
     hal_sig_t *s = hal_find(K_SIG, name);
-    if (!s)
-        r = hal_fail(ENOENT, "signal '%s' not found", name);
-    else if (hal_map.hdr->lock & HAL_LOCK_CONFIG)
-        r = hal_fail(EPERM, "signal '%s': HAL is locked against "
-                     "configuration", name);
+    if (hal_map.hdr->lock & HAL_LOCK_CONFIG)
+        r = fail_locked(K_SIG, name, "signal '%s': HAL is locked against "
+                        "configuration");
+    else if (!s)
+        r = fail_not_found(K_SIG, name);
     if (!r) {
         hoff_t so = SHMOFF(s);
         FOR_EACH(K_PIN, hal_pin_t, p)
@@ -872,40 +961,68 @@ int hal_signal_delete(const char *name)
     return r;
 }
 
-int hal_link(const char *pin_name, const char *sig_name)
+/* the pin linked to s that a new pin of direction dir conflicts with
+   (the first by name, as halcmd reports it), or NULL; lock held */
+static hal_pin_t *conflicting_pin(hal_sig_t *s, int dir)
 {
-    int r = hal_lock();
-    if (r)
-        return r;
-    hal_pin_t *p = hal_find(K_PIN, pin_name);
-    hal_sig_t *s = hal_find(K_SIG, sig_name);
-    if (hal_map.hdr->lock & HAL_LOCK_CONFIG)
-        r = hal_fail(EPERM, "cannot link '%s': HAL is locked against "
-                     "configuration", pin_name);
-    else if (!p)
-        r = hal_fail(ENOENT, "pin '%s' not found", pin_name);
-    else if (!s)
-        r = hal_fail(ENOENT, "signal '%s' not found", sig_name);
-    else if (p->signal == SHMOFF(s))
-        goto out;           /* already there */
-    else if (p->signal)
-        r = hal_fail(EBUSY, "Pin '%s' was already linked to signal '%s'",
-                     pin_name, ((hal_sig_t *)SHMPTR(p->signal))->o.name);
-    else if (p->type != s->type)
-        r = hal_fail(EPROTOTYPE, "Signal '%s' of type '%s' cannot add pin "
-                     "'%s' of type '%s'", sig_name, type_word(s->type),
-                     pin_name, type_word(p->type));
-    else if (p->dir == HALSDK_OUT && s->writers > 0)
-        r = hal_fail(EBUSY, "signal '%s' already has an output pin, "
-                     "cannot add output pin '%s'", sig_name, pin_name);
-    else if (p->dir == HALSDK_OUT && s->bidirs > 0)
-        r = hal_fail(EBUSY, "signal '%s' has I/O pins, cannot add output "
-                     "pin '%s'", sig_name, pin_name);
-    else if (p->dir == HALSDK_IO && s->writers > 0)
-        r = hal_fail(EBUSY, "signal '%s' has an output pin, cannot add "
-                     "I/O pin '%s'", sig_name, pin_name);
-    if (r)
-        goto out;
+    hal_pin_t *best = NULL;
+    hoff_t so = SHMOFF(s);
+    if (dir == HALSDK_IN)
+        return NULL;
+    FOR_EACH(K_PIN, hal_pin_t, q)
+        if (q->signal == so &&
+            (q->dir == HALSDK_OUT || (q->dir == HALSDK_IO &&
+                                      dir == HALSDK_OUT)) &&
+            (!best || strcmp(q->o.name, best->o.name) < 0))
+            best = q;
+    return best;
+}
+
+/* may pin p join signal sig_name of type `type`, that has `writers` out
+   and `bidirs` io pins (of which `other` is one, maybe NULL)?  Lock held.
+   The rules of a link, in the order the reference checks them. */
+static int link_check(hal_pin_t *p, const char *sig_name, int type,
+                      int writers, int bidirs, const char *other)
+{
+    const char *pin_name = p->o.name;
+    if (p->signal) {
+        const char *cur = ((hal_sig_t *)SHMPTR(p->signal))->o.name;
+        return hal_rule(hal_fail(EBUSY, "Pin '%s' was already linked to "
+                                 "signal '%s'", pin_name, cur),
+                        HAL_RULE_PIN_LINKED, K_PIN, pin_name, cur,
+                        sig_name);
+    }
+    if (p->type != type)
+        return hal_rule(hal_fail(EPROTOTYPE, "Signal '%s' of type '%s' "
+                                 "cannot add pin '%s' of type '%s'",
+                                 sig_name, type_word(type), pin_name,
+                                 type_word(p->type)),
+                        HAL_RULE_TYPE_MISMATCH, K_SIG, sig_name, pin_name,
+                        NULL);
+    if (p->dir == HALSDK_OUT && writers > 0)
+        return hal_rule(hal_fail(EBUSY, "signal '%s' already has an output "
+                                 "pin, cannot add output pin '%s'",
+                                 sig_name, pin_name),
+                        HAL_RULE_SECOND_WRITER, K_SIG, sig_name, pin_name,
+                        other);
+    if (p->dir == HALSDK_OUT && bidirs > 0)
+        return hal_rule(hal_fail(EBUSY, "signal '%s' has I/O pins, cannot "
+                                 "add output pin '%s'", sig_name,
+                                 pin_name),
+                        HAL_RULE_WRITER_AND_IO, K_SIG, sig_name, pin_name,
+                        other);
+    if (p->dir == HALSDK_IO && writers > 0)
+        return hal_rule(hal_fail(EBUSY, "signal '%s' has an output pin, "
+                                 "cannot add I/O pin '%s'", sig_name,
+                                 pin_name),
+                        HAL_RULE_WRITER_AND_IO, K_SIG, sig_name, pin_name,
+                        other);
+    return 0;
+}
+
+/* link a checked pin; lock held */
+static void link_locked(hal_pin_t *p, hal_sig_t *s)
+{
     /* the first pin of a signal gives the signal its value */
     if (s->readers == 0 && s->writers == 0 && s->bidirs == 0)
         s->value.lu = p->dummy.lu;
@@ -918,6 +1035,139 @@ int hal_link(const char *pin_name, const char *sig_name)
     p->signal = SHMOFF(s);
     write_cell(p, &s->value);
     hal_map.hdr->serial++;
+}
+
+int hal_link(const char *pin_name, const char *sig_name)
+{
+    int r = hal_lock();
+    if (r)
+        return r;
+    hal_pin_t *p = hal_find(K_PIN, pin_name);
+    hal_sig_t *s = hal_find(K_SIG, sig_name);
+    if (hal_map.hdr->lock & HAL_LOCK_CONFIG)
+        r = fail_locked(K_PIN, pin_name, "cannot link '%s': HAL is locked "
+                        "against configuration");
+    else if (!p)
+        r = fail_not_found(K_PIN, pin_name);
+    else if (!s)
+        r = fail_not_found(K_SIG, sig_name);
+    else if (p->signal == SHMOFF(s))
+        goto out;           /* already there */
+    else {
+        hal_pin_t *other = conflicting_pin(s, p->dir);
+        r = link_check(p, sig_name, s->type, s->writers, s->bidirs,
+                       other ? other->o.name : NULL);
+    }
+    if (!r)
+        link_locked(p, s);
+out:
+    hal_unlock();
+    return r;
+}
+
+/*
+ * Link pins to a signal, creating it with the first pin's type: every
+ * pin is checked against the signal and against the pins before it, and
+ * nothing changes unless all may be linked.  Pins already on the signal
+ * stay.  The order of the checks is the reference halcmd's.
+ */
+int hal_net(const char *sig_name, const char *const *pins, int npins)
+{
+    if (!sig_name)
+        return hal_fail(EINVAL, "net: no signal name");
+    int r = hal_lock();
+    if (r)
+        return r;
+    hal_header_t *h = hal_map.hdr;
+    hal_sig_t *s = hal_find(K_SIG, sig_name);
+    hoff_t so = s ? SHMOFF(s) : 0;
+    int type = 0, writers = 0, bidirs = 0;
+    const char *writer = NULL, *bidir = NULL;
+    if (hal_find(K_PIN, sig_name)) {
+        r = hal_rule(hal_fail(EINVAL, "Signal name '%s' must not be the "
+                              "same as a pin.  Did you omit the signal "
+                              "name?", sig_name),
+                     HAL_RULE_NAME_IS_PIN, K_SIG, sig_name, NULL, NULL);
+        goto out;
+    }
+    if (npins <= 0) {
+        r = hal_rule(hal_fail(EINVAL, "net '%s': no pins given", sig_name),
+                     HAL_RULE_NO_PINS, K_SIG, sig_name, NULL, NULL);
+        goto out;
+    }
+    /* each pin against the signal as it is */
+    for (int k = 0; k < npins; k++) {
+        hal_pin_t *p = hal_find(K_PIN, pins[k]);
+        if (!p) {
+            r = fail_not_found(K_PIN, pins[k]);
+            goto out;
+        }
+        if (p->signal && p->signal == so)
+            continue;
+        if (!s) {
+            if (p->signal)
+                r = link_check(p, sig_name, p->type, 0, 0, NULL);
+            if (r)
+                goto out;
+            continue;
+        }
+        hal_pin_t *other = conflicting_pin(s, p->dir);
+        r = link_check(p, sig_name, s->type, s->writers, s->bidirs,
+                       other ? other->o.name : NULL);
+        if (r)
+            goto out;
+    }
+    /* then against each other: one type, one writer or io pins */
+    if (s) {
+        type = s->type;
+        writers = s->writers;
+        bidirs = s->bidirs;
+    } else {
+        type = ((hal_pin_t *)hal_find(K_PIN, pins[0]))->type;
+    }
+    for (int k = 0; k < npins && !s; k++) {
+        hal_pin_t *p = hal_find(K_PIN, pins[k]);
+        if ((r = link_check(p, sig_name, type, 0, 0, NULL)))
+            goto out;
+    }
+    for (int k = 0; k < npins; k++) {
+        hal_pin_t *p = hal_find(K_PIN, pins[k]);
+        if (p->signal && p->signal == so)
+            continue;
+        r = link_check(p, sig_name, type, writers, bidirs,
+                       p->dir == HALSDK_OUT && writer ? writer
+                       : p->dir == HALSDK_OUT ? bidir : writer);
+        if (r)
+            goto out;
+        if (p->dir == HALSDK_OUT) {
+            writers++;
+            writer = p->o.name;
+        } else if (p->dir == HALSDK_IO) {
+            bidirs++;
+            bidir = p->o.name;
+        }
+    }
+    if (h->lock & HAL_LOCK_CONFIG) {
+        r = s ? fail_locked(K_PIN, pins[0], "cannot link '%s': HAL is "
+                            "locked against configuration")
+              : fail_locked(K_SIG, sig_name, "signal '%s': HAL is locked "
+                            "against configuration");
+        goto out;
+    }
+    if (!s) {
+        if ((r = hal_check_name(sig_name, "signal")))
+            goto out;
+        if (!(s = signal_make(sig_name, type))) {
+            r = -ENOMEM;
+            goto out;
+        }
+        so = SHMOFF(s);
+    }
+    for (int k = 0; k < npins; k++) {
+        hal_pin_t *p = hal_find(K_PIN, pins[k]);
+        if (p->signal != so)
+            link_locked(p, s);
+    }
 out:
     hal_unlock();
     return r;
@@ -930,14 +1180,57 @@ int hal_unlink(const char *pin_name)
         return r;
     hal_pin_t *p = hal_find(K_PIN, pin_name);
     if (hal_map.hdr->lock & HAL_LOCK_CONFIG)
-        r = hal_fail(EPERM, "cannot unlink '%s': HAL is locked against "
-                     "configuration", pin_name);
+        r = fail_locked(K_PIN, pin_name, "cannot unlink '%s': HAL is locked "
+                        "against configuration");
     else if (!p)
-        r = hal_fail(ENOENT, "pin '%s' not found", pin_name);
+        r = fail_not_found(K_PIN, pin_name);
     else if (p->signal)
         unlink_locked(p);
     hal_unlock();
     return r;
+}
+
+/* may setp/sets write this record? */
+int hal_check_settable(const hal_obj_t *o, int flags)
+{
+    hal_header_t *h = hal_map.hdr;
+    if (!h)
+        return hal_fail(ENODEV, "no HAL instance is attached");
+    if (!(flags & HAL_SET_IGNORE_LOCK) && (h->lock & HAL_LOCK_PARAMS))
+        return hal_rule(hal_fail(EPERM, "cannot set %s '%s': HAL is locked "
+                                 "against setting values",
+                                 kind_word(o->kind), o->name),
+                        HAL_RULE_LOCKED, o->kind, o->name, NULL, NULL);
+    if (o->kind == K_PIN) {
+        const hal_pin_t *p = (const hal_pin_t *)o;
+        if (p->dir == HALSDK_OUT)
+            return hal_rule(hal_fail(EPERM, "pin '%s' is not writable",
+                                     o->name),
+                            HAL_RULE_WRITE_OUTPUT, K_PIN, o->name, NULL,
+                            NULL);
+        if (p->signal)
+            return hal_rule(hal_fail(EBUSY, "pin '%s' is connected to a "
+                                     "signal", o->name),
+                            HAL_RULE_PIN_CONNECTED, K_PIN, o->name,
+                            ((hal_sig_t *)SHMPTR(p->signal))->o.name, NULL);
+    } else if (o->kind == K_PARAM) {
+        if (((const hal_param_t *)o)->dir == HALSDK_RO)
+            return hal_rule(hal_fail(EPERM, "param '%s' is not writable",
+                                     o->name),
+                            HAL_RULE_RO_PARAM, K_PARAM, o->name, NULL, NULL);
+    } else if (o->kind == K_SIG) {
+        /* io pins do not count, as in the reference */
+        if (((const hal_sig_t *)o)->writers > 0)
+            return hal_rule(hal_fail(EBUSY, "signal '%s' already has "
+                                     "writer(s)", o->name),
+                            HAL_RULE_SIG_HAS_WRITER, K_SIG, o->name, NULL,
+                            NULL);
+    } else {
+        return hal_rule(hal_fail(EINVAL, "%s '%s' has no value",
+                                 kind_word(o->kind), o->name),
+                        HAL_RULE_BAD_ARG, o->kind, o->name, NULL, NULL);
+    }
+    return 0;
 }
 
 /* ---------------------------------------------------------------- */
@@ -972,7 +1265,7 @@ static int names_free(const char *base, const char *const *suffixes)
             return hal_fail(EINVAL, "name '%s' is longer than %d "
                             "characters", n, HALSDK_NAME_LEN);
         if (find_in_space(K_PIN, n))
-            return hal_fail(EEXIST, "duplicate pin or param name '%s'", n);
+            return fail_exists(K_PIN, n, "duplicate pin or param name '%s'");
     }
     return 0;
 }
@@ -988,8 +1281,10 @@ int hal_export_funct(const char *name, halsdk_funct_t fn, void *arg,
     if (!hal_map.hdr)
         return hal_fail(ENODEV, "no HAL instance is attached");
     if (!hal_map.is_host)
-        return hal_fail(EPERM, "function '%s': only components loaded in "
-                        "the host process (loadrt) export functions", name);
+        return hal_rule(hal_fail(EPERM, "function '%s': only components "
+                                 "loaded in the host process (loadrt) "
+                                 "export functions", name),
+                        HAL_RULE_HOST_ONLY, K_FUNCT, name, NULL, NULL);
     if (!fn)
         return hal_fail(EINVAL, "function '%s': no entry point", name);
     if ((r = hal_lock()))
@@ -999,7 +1294,7 @@ int hal_export_funct(const char *name, halsdk_funct_t fn, void *arg,
     if ((r = resolve_owner(owner_id, &c, &i, "function", name)))
         goto out;
     if (find_in_space(K_FUNCT, name)) {
-        r = hal_fail(EEXIST, "duplicate function name '%s'", name);
+        r = fail_exists(K_FUNCT, name, "duplicate function name '%s'");
         goto out;
     }
     if ((r = names_free(name, sfx)))
@@ -1060,24 +1355,28 @@ int hal_thread_new(const char *name, long period, int uses_fp,
     if (!hal_map.hdr)
         return hal_fail(ENODEV, "no HAL instance is attached");
     if (!hal_map.is_host)
-        return hal_fail(EPERM, "thread '%s': threads are created by the "
-                        "host process", name);
+        return hal_rule(hal_fail(EPERM, "thread '%s': threads are created "
+                                 "by the host process", name),
+                        HAL_RULE_HOST_ONLY, K_THREAD, name, NULL, NULL);
     if (period < 1000)
-        return hal_fail(EINVAL, "thread '%s': period %ld ns is shorter "
-                        "than 1000 ns", name, period);
+        return hal_rule(hal_fail(EINVAL, "thread '%s': period %ld ns is "
+                                 "shorter than 1000 ns", name, period),
+                        HAL_RULE_BAD_ARG, K_THREAD, name, NULL, NULL);
     if (snprintf(n, sizeof(n), "__%s", name) > HALSDK_NAME_LEN)
         return hal_fail(EINVAL, "thread name '%s' is too long", name);
     if ((r = hal_lock()))
         return r;
     hal_header_t *h = hal_map.hdr;
     if (find_in_space(K_THREAD, name))
-        r = hal_fail(EEXIST, "duplicate thread name '%s'", name);
+        r = fail_exists(K_THREAD, name, "duplicate thread name '%s'");
     else if (find_in_space(K_COMP, n))
-        r = hal_fail(EEXIST, "thread '%s': component name '%s' is taken",
-                     name, n);
+        r = hal_rule(hal_fail(EEXIST, "thread '%s': component name '%s' is "
+                              "taken", name, n),
+                     HAL_RULE_EXISTS, K_COMP, n, name, NULL);
     else if (h->count[K_THREAD] >= HAL_MAX_THREADS)
-        r = hal_fail(ENOSPC, "thread '%s': at most %d threads",
-                     name, HAL_MAX_THREADS);
+        r = hal_rule(hal_fail(ENOSPC, "thread '%s': at most %d threads",
+                              name, HAL_MAX_THREADS),
+                     HAL_RULE_FULL, K_THREAD, name, NULL, NULL);
     else
         r = names_free(name, sfx);
     if (r)
@@ -1183,10 +1482,11 @@ int hal_thread_delete(const char *name)
         return r;
     hal_thread_t *t = hal_find(K_THREAD, name);
     if (!t)
-        r = hal_fail(ENOENT, "thread '%s' not found", name);
+        r = fail_not_found(K_THREAD, name);
     else if (!hal_map.is_host)
-        r = hal_fail(EPERM, "thread '%s': only the host deletes threads",
-                     name);
+        r = hal_rule(hal_fail(EPERM, "thread '%s': only the host deletes "
+                              "threads", name),
+                     HAL_RULE_HOST_ONLY, K_THREAD, name, NULL, NULL);
     else if (exec_stepping())
         r = hal_fail(EBUSY, "thread '%s' is being stepped", name);
     else
@@ -1203,26 +1503,30 @@ int hal_addf(const char *funct, const char *thread, int position)
     hal_funct_t *f = hal_find(K_FUNCT, funct);
     hal_thread_t *t = hal_find(K_THREAD, thread);
     if (hal_map.hdr->lock & HAL_LOCK_CONFIG)
-        r = hal_fail(EPERM, "addf '%s': HAL is locked against "
-                     "configuration", funct);
+        r = fail_locked(K_FUNCT, funct, "addf '%s': HAL is locked against "
+                        "configuration");
     else if (!f)
-        r = hal_fail(ENOENT, "function '%s' not found", funct);
+        r = fail_not_found(K_FUNCT, funct);
     else if (!t)
-        r = hal_fail(ENOENT, "thread '%s' not found", thread);
+        r = fail_not_found(K_THREAD, thread);
     else if (!hal_map.is_host)
-        r = hal_fail(EPERM, "addf '%s': only the host changes threads",
-                     funct);
-    else if (f->users > 0 && !f->reentrant)
-        r = hal_fail(EINVAL, "function '%s' may only be added to one "
-                     "thread", funct);
-    else if (f->uses_fp && !t->uses_fp)
-        r = hal_fail(EINVAL, "function '%s' needs FP, thread '%s' has no "
-                     "FP", funct, thread);
+        r = hal_rule(hal_fail(EPERM, "addf '%s': only the host changes "
+                              "threads", funct),
+                     HAL_RULE_HOST_ONLY, K_FUNCT, funct, thread, NULL);
     else if (position == 0 || position > t->nfuncts + 1 ||
              position < -(t->nfuncts + 1))
-        r = hal_fail(EINVAL, "addf '%s': position %d is out of range for "
-                     "thread '%s' with %d functions", funct, position,
-                     thread, t->nfuncts);
+        r = hal_rule(hal_fail(EINVAL, "addf '%s': position %d is out of "
+                              "range for thread '%s' with %d functions",
+                              funct, position, thread, t->nfuncts),
+                     HAL_RULE_BAD_POSITION, K_FUNCT, funct, thread, NULL);
+    else if (f->users > 0 && !f->reentrant)
+        r = hal_rule(hal_fail(EINVAL, "function '%s' may only be added to "
+                              "one thread", funct),
+                     HAL_RULE_NOT_REENTRANT, K_FUNCT, funct, thread, NULL);
+    else if (f->uses_fp && !t->uses_fp)
+        r = hal_rule(hal_fail(EINVAL, "function '%s' needs FP, thread '%s' "
+                              "has no FP", funct, thread),
+                     HAL_RULE_NEEDS_FP, K_FUNCT, funct, thread, NULL);
     if (r)
         goto out;
     hal_fentry_t *e = hal_alloc(sizeof(*e), 0);
@@ -1260,15 +1564,20 @@ int hal_delf(const char *funct, const char *thread)
     hal_funct_t *f = hal_find(K_FUNCT, funct);
     hal_thread_t *t = hal_find(K_THREAD, thread);
     if (hal_map.hdr->lock & HAL_LOCK_CONFIG)
-        r = hal_fail(EPERM, "delf '%s': HAL is locked against "
-                     "configuration", funct);
+        r = fail_locked(K_FUNCT, funct, "delf '%s': HAL is locked against "
+                        "configuration");
     else if (!f)
-        r = hal_fail(ENOENT, "function '%s' not found", funct);
+        r = fail_not_found(K_FUNCT, funct);
+    else if (f->users == 0)
+        r = hal_rule(hal_fail(ENOENT, "function '%s' is not in thread '%s'",
+                              funct, thread),
+                     HAL_RULE_FUNCT_UNUSED, K_FUNCT, funct, thread, NULL);
     else if (!t)
-        r = hal_fail(ENOENT, "thread '%s' not found", thread);
+        r = fail_not_found(K_THREAD, thread);
     else if (!hal_map.is_host)
-        r = hal_fail(EPERM, "delf '%s': only the host changes threads",
-                     funct);
+        r = hal_rule(hal_fail(EPERM, "delf '%s': only the host changes "
+                              "threads", funct),
+                     HAL_RULE_HOST_ONLY, K_FUNCT, funct, thread, NULL);
     if (r)
         goto out;
     /* remove the first entry only, as the reference does */
@@ -1276,8 +1585,9 @@ int hal_delf(const char *funct, const char *thread)
     while (*link && ((hal_fentry_t *)SHMPTR(*link))->funct != fo)
         link = &((hal_fentry_t *)SHMPTR(*link))->next;
     if (!*link) {
-        r = hal_fail(ENOENT, "function '%s' is not in thread '%s'",
-                     funct, thread);
+        r = hal_rule(hal_fail(ENOENT, "function '%s' is not in thread '%s'",
+                              funct, thread),
+                     HAL_RULE_NOT_IN_THREAD, K_FUNCT, funct, thread, NULL);
         goto out;
     }
     hal_fentry_t *e = SHMPTR(*link);
@@ -1345,9 +1655,7 @@ long long hal_handle_attach(int kind, const char *name)
     if (r)
         return r;
     hal_obj_t *o = hal_find(kind, name);
-    long long ret = o ? hal_handle_of(o)
-                      : hal_fail(ENOENT, "%s '%s' not found",
-                                 kind_word(kind), name);
+    long long ret = o ? hal_handle_of(o) : fail_not_found(kind, name);
     hal_unlock();
     return ret;
 }
@@ -1399,7 +1707,7 @@ int hal_inst_delete(const char *name)
     hal_inst_t *i = hal_find(K_INST, name);
     if (!i) {
         hal_unlock();
-        return hal_fail(ENOENT, "instance '%s' not found", name);
+        return fail_not_found(K_INST, name);
     }
     hal_comp_t *c = SHMPTR(i->comp);
     delete_items_of(i->comp, SHMOFF(i));

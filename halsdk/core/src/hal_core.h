@@ -239,10 +239,52 @@ extern hal_map_t hal_map;       /* the instance this process uses */
 #define SHMPTR(off) ((void *)(hal_map.base + (off)))
 #define SHMOFF(ptr) ((hoff_t)((char *)(ptr) - hal_map.base))
 
-/* error reporting: returns -err and keeps a message */
+/*
+ * The rules of HAL.  A failing operation reports -errno, a message naming
+ * the objects (hal_last_error) and the rule it enforces (hal_last_rule),
+ * with the kind of the first object and up to three object names
+ * (hal_last_name), in the order given here.  Front ends turn the rule and
+ * the names into their own words (halcmd: the reference's).  This enum is
+ * the only list of HAL rules; halsdk.errors.Rule mirrors it.
+ */
+enum hal_rule {
+    HAL_RULE_NONE = 0,          /* success, or a failure without a rule */
+    HAL_RULE_NOT_FOUND,         /* object (of hal_last_kind) */
+    HAL_RULE_EXISTS,            /* name (of hal_last_kind) */
+    HAL_RULE_BAD_NAME,          /* name */
+    HAL_RULE_LOCKED,            /* object (of hal_last_kind) */
+    HAL_RULE_PIN_LINKED,        /* pin, its signal, the signal asked for */
+    HAL_RULE_TYPE_MISMATCH,     /* signal, pin */
+    HAL_RULE_SECOND_WRITER,     /* signal, out pin, the writer there */
+    HAL_RULE_WRITER_AND_IO,     /* signal, pin, the pin it conflicts with */
+    HAL_RULE_NAME_IS_PIN,       /* signal: net's signal name is a pin */
+    HAL_RULE_NO_PINS,           /* signal: net without pins */
+    HAL_RULE_SIG_HAS_WRITER,    /* signal: sets of a driven signal */
+    HAL_RULE_WRITE_OUTPUT,      /* pin: setp of an out pin */
+    HAL_RULE_PIN_CONNECTED,     /* pin, signal: setp of a linked pin */
+    HAL_RULE_RO_PARAM,          /* param: setp of a read-only param */
+    HAL_RULE_NOT_REENTRANT,     /* function, thread */
+    HAL_RULE_NEEDS_FP,          /* function, thread */
+    HAL_RULE_BAD_POSITION,      /* function, thread */
+    HAL_RULE_FUNCT_UNUSED,      /* function: delf of one in no thread */
+    HAL_RULE_NOT_IN_THREAD,     /* function, thread */
+    HAL_RULE_HOST_ONLY,         /* object: only the host may do it */
+    HAL_RULE_NOT_OWNER,         /* component: of another process */
+    HAL_RULE_FULL,              /* object: the instance is full */
+    HAL_RULE_BAD_ARG,           /* object: a bad type, direction, size */
+    HAL_RULE_NRULES
+};
+
+/* error reporting: returns -err and keeps a message (rule NONE) */
 int hal_fail(int err, const char *fmt, ...)
     __attribute__((format(printf, 2, 3)));
+/* attach a rule to the failure r that hal_fail just made; returns r */
+int hal_rule(int r, int rule, int kind, const char *name0,
+             const char *name1, const char *name2);
 const char *hal_last_error(void);
+int hal_last_rule(void);
+int hal_last_kind(void);
+const char *hal_last_name(int index);      /* "" when absent */
 
 /* instance */
 int hal_instance_create(const char *shm_name, const char *instance,
@@ -288,6 +330,7 @@ int hal_unalias(int kind, const char *alias);
 int hal_signal_new(const char *name, int type);
 int hal_signal_delete(const char *name);
 int hal_link(const char *pin_name, const char *sig_name);
+int hal_net(const char *sig_name, const char *const *pins, int npins);
 int hal_unlink(const char *pin_name);
 int hal_export_funct(const char *name, halsdk_funct_t fn, void *arg,
                      int uses_fp, int reentrant, int owner_id, int python);
@@ -298,6 +341,11 @@ int hal_addf(const char *funct, const char *thread, int position);
 int hal_delf(const char *funct, const char *thread);
 int hal_stop_threads(void);
 int hal_set_lock(unsigned char lock);
+/* may setp/sets write this pin, param or signal record?  0 or -errno;
+   HAL_SET_IGNORE_LOCK skips the params lock (halcmd's setp and sets do,
+   as the reference's) */
+#define HAL_SET_IGNORE_LOCK 1
+int hal_check_settable(const hal_obj_t *o, int flags);
 int hal_check_consistency(char *report, int len);
 
 /* streams (hal_stream.c); handles pack (gen << 32) | offset */

@@ -346,9 +346,13 @@ int exec_start(int slot, int want_rt, char *note, int notelen)
 static int start_allowed(void)
 {
     if (!hal_map.is_host)
-        return hal_fail(EPERM, "only the host process starts threads");
+        return hal_rule(hal_fail(EPERM, "only the host process starts "
+                                 "threads"),
+                        HAL_RULE_HOST_ONLY, K_THREAD, NULL, NULL, NULL);
     if (hal_map.hdr->lock & HAL_LOCK_RUN)
-        return hal_fail(EPERM, "HAL is locked against starting threads");
+        return hal_rule(hal_fail(EPERM, "HAL is locked against starting "
+                                 "threads"),
+                        HAL_RULE_LOCKED, K_THREAD, NULL, NULL, NULL);
     if (atomic_load(&stepping))
         return hal_fail(EBUSY, "threads are being stepped");
     return 0;
@@ -357,9 +361,13 @@ static int start_allowed(void)
 int hal_stop_threads(void)
 {
     if (!hal_map.is_host)
-        return hal_fail(EPERM, "only the host process stops threads");
+        return hal_rule(hal_fail(EPERM, "only the host process stops "
+                                 "threads"),
+                        HAL_RULE_HOST_ONLY, K_THREAD, NULL, NULL, NULL);
     if (hal_map.hdr->lock & HAL_LOCK_RUN)
-        return hal_fail(EPERM, "HAL is locked against stopping threads");
+        return hal_rule(hal_fail(EPERM, "HAL is locked against stopping "
+                                 "threads"),
+                        HAL_RULE_LOCKED, K_THREAD, NULL, NULL, NULL);
     for (int s = 0; s < HAL_MAX_THREADS; s++)
         exec_stop(s);
     hal_map.hdr->threads_running = 0;
