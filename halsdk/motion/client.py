@@ -1324,10 +1324,10 @@ def homing_fields(keys: Mapping[str, Any], where: str = "") -> dict:
 
 def read_comp_file(path: str, type: int = 0) -> list:
     """Entries (nominal, forward trim, reverse trim) of a compensation file
-    of COMP_FILE_TYPE ``type`` (halsdk.motion.compfile; a malformed file
+    of COMP_FILE_TYPE ``type`` (halsdk.motion.screwcomp; a malformed file
     raises CompFileError naming the line)."""
-    from halsdk.motion import compfile
-    return [tuple(e) for e in compfile.read_comp_file(path, type)]
+    from halsdk.motion import screwcomp
+    return [tuple(e) for e in screwcomp.read_comp_file(path, type)]
 
 
 def _num(keys: Mapping[str, Any], key: str, where: str) -> float:
