@@ -70,9 +70,19 @@ cdef extern from "emcpose.h":
         double a, b, c, u, v, w
 
 cdef extern from "channel.h":
-    int MOT_CHANNEL_MAGIC, MOT_CHANNEL_VERSION, MOT_MAX_JOINTS
-    int MOT_MAX_AXES, MOT_REASON_LEN, MOT_MSG_LEN, MOT_MSG_RING
-    int MOT_QUEUE_SIZE, MOT_MAX_SPINDLES, MOT_MAX_AIO
+    enum:
+        MOT_CHANNEL_MAGIC
+        MOT_CHANNEL_VERSION
+        MOT_MAX_JOINTS
+        MOT_MAX_AXES
+        MOT_REASON_LEN
+        MOT_MSG_LEN
+        MOT_MSG_RING
+        MOT_QUEUE_SIZE
+        MOT_MAX_SPINDLES
+        MOT_MAX_AIO
+
+    # (the array sizes below are the headers' #defines)
 
     ctypedef struct mot_command_t:
         int32_t cmd, joint, axis, ival, index, id, motion_type, turn
@@ -125,36 +135,36 @@ cdef extern from "channel.h":
         int32_t carte_pos_fb_ok
         EmcPose probed_pos, tool_offset
         uint64_t dout, din
-        mot_joint_status_t joint[16]
-        mot_axis_status_t axis[9]
+        mot_joint_status_t joint[MOT_MAX_JOINTS]
+        mot_axis_status_t axis[MOT_MAX_AXES]
         int32_t program_line, feed_hold_enabled, adaptive_enabled
         int32_t feed_hold, feed_inhibit, queue_taken
         uint32_t queue_err_count
         double adaptive_feed, feed_upm, linear_units
-        double ain[64]
-        double aout[64]
-        mot_spindle_status_t spindle[8]
+        double ain[MOT_MAX_AIO]
+        double aout[MOT_MAX_AIO]
+        mot_spindle_status_t spindle[MOT_MAX_SPINDLES]
         int32_t spindle_wait, queue_held
 
     ctypedef struct mot_msg_t:
         uint64_t n
-        char text[200]
+        char text[MOT_MSG_LEN]
 
     ctypedef struct mot_channel_t:
         uint32_t magic, version, size
         int32_t lock_pid
         uint32_t cmd_seq, echo_seq
         int32_t echo_status, echo_cmd
-        char echo_reason[200]
+        char echo_reason[MOT_REASON_LEN]
         mot_command_t command
         uint32_t status_seq
         mot_status_t status
         uint64_t msg_count
-        mot_msg_t msgs[32]
+        mot_msg_t msgs[MOT_MSG_RING]
         uint32_t q_head, q_tail, q_err_count
         int32_t q_err_cmd, q_err_id, q_err_line
-        char q_err_reason[200]
-        mot_command_t queue[1]
+        char q_err_reason[MOT_REASON_LEN]
+        mot_command_t queue[MOT_QUEUE_SIZE]
 
 
 # ------------------------------------------------------------ protocol
@@ -398,7 +408,7 @@ cdef tuple _pose(EmcPose *p):
 
 
 cdef void _set_pose(EmcPose *p, object v) except *:
-    if len(v) != 9:
+    if len(v) != MOT_MAX_AXES:
         raise ValueError("a pose needs 9 values (X Y Z A B C U V W)")
     p.tran.x, p.tran.y, p.tran.z = v[0], v[1], v[2]
     p.a, p.b, p.c, p.u, p.v, p.w = v[3], v[4], v[5], v[6], v[7], v[8]
@@ -420,7 +430,14 @@ _KNOWN = set(_INT_FIELDS + _FLOAT_FIELDS +
              ("home_flags", "comp", "pos", "center", "normal"))
 
 SIZE = sizeof(mot_channel_t)
+MAGIC = MOT_CHANNEL_MAGIC
+VERSION = MOT_CHANNEL_VERSION
 MAX_JOINTS = MOT_MAX_JOINTS
+MAX_AXES = MOT_MAX_AXES
+MAX_SPINDLES = MOT_MAX_SPINDLES
+MAX_AIO = MOT_MAX_AIO
+REASON_LEN = MOT_REASON_LEN
+MSG_LEN = MOT_MSG_LEN
 MSG_RING = MOT_MSG_RING
 QUEUE_SIZE = MOT_QUEUE_SIZE
 
@@ -556,9 +573,9 @@ cdef class Channel:
         cdef uint32_t seq = mch_load32(&c.echo_seq)
         cdef int32_t st = c.echo_status
         cdef int32_t code = c.echo_cmd
-        cdef char reason[200]
-        memcpy(reason, c.echo_reason, 200)
-        reason[199] = 0
+        cdef char reason[MOT_REASON_LEN]
+        memcpy(reason, c.echo_reason, MOT_REASON_LEN)
+        reason[MOT_REASON_LEN - 1] = 0
         return seq, st, code, reason.decode("utf-8", "replace")
 
     # ---------------------------------------------------------- queue
@@ -604,9 +621,9 @@ cdef class Channel:
         queued record."""
         cdef mot_channel_t *c = self.live()
         cdef uint32_t n = mch_load32(&c.q_err_count)
-        cdef char reason[200]
-        memcpy(reason, c.q_err_reason, 200)
-        reason[199] = 0
+        cdef char reason[MOT_REASON_LEN]
+        memcpy(reason, c.q_err_reason, MOT_REASON_LEN)
+        reason[MOT_REASON_LEN - 1] = 0
         return (n, c.q_err_cmd, c.q_err_id, c.q_err_line,
                 reason.decode("utf-8", "replace"))
 
@@ -672,7 +689,7 @@ cdef class Channel:
                 lost += 1
                 r += 1
                 continue
-            m.text[199] = 0
+            m.text[MOT_MSG_LEN - 1] = 0
             out.append(m.text.decode("utf-8", "replace"))
             r += 1
         return out, r, lost
