@@ -9,6 +9,7 @@ timeouts and decoding belong to :mod:`halsdk.motion.client`.
 
 from cpython.pycapsule cimport PyCapsule_GetPointer
 from libc.stdint cimport int32_t, uint32_t, uint64_t, uintptr_t
+from libc.stdlib cimport calloc, free
 from libc.string cimport memcpy, memset
 
 cdef extern from *:
@@ -382,6 +383,280 @@ PROFILE = {"TRAPEZOID": FP_TRAPEZOID, "JERK": FP_JERK}
 HOME_SEQ_NONE = HOME_SEQUENCE_NONE
 CMD_LAST = MOT_CMD_LAST     # every command code is below this
 
+
+
+# ------------------------------------------------------------ layout
+# Where the compiler put the fields of the channel's structures (the
+# headers' layout, offsetof): LAYOUT[struct] = (sizeof, fields), the
+# fields in order as (name, offset, kind, count): kind "i32", "u32",
+# "u64", "f64", "char" or another struct of LAYOUT, count > 1 for an
+# array (the headers' sizes).  Padding and reserved fields are left out;
+# a pose is listed by axis letters (x y z a b c u v w).  For tools and
+# tests that look at the block with ctypes; the client uses the typed
+# access above.
+
+cdef tuple _f(str name, const volatile void *base, const volatile void *at,
+              str kind, size_t count=1):
+    return (name, <size_t>(<const volatile char *>at -
+                           <const volatile char *>base), kind, count)
+
+
+cdef tuple _layout_PmCartesian():
+    cdef PmCartesian s
+    cdef void *b = &s
+    return sizeof(s), (
+        _f("x", b, &s.x, "f64"),
+        _f("y", b, &s.y, "f64"),
+        _f("z", b, &s.z, "f64"),
+    )
+
+
+cdef tuple _layout_EmcPose():
+    cdef EmcPose s
+    cdef void *b = &s
+    return sizeof(s), (
+        _f("x", b, &s.tran.x, "f64"),
+        _f("y", b, &s.tran.y, "f64"),
+        _f("z", b, &s.tran.z, "f64"),
+        _f("a", b, &s.a, "f64"),
+        _f("b", b, &s.b, "f64"),
+        _f("c", b, &s.c, "f64"),
+        _f("u", b, &s.u, "f64"),
+        _f("v", b, &s.v, "f64"),
+        _f("w", b, &s.w, "f64"),
+    )
+
+
+cdef tuple _layout_command():
+    cdef mot_command_t s
+    cdef void *b = &s
+    return sizeof(s), (
+        _f("cmd", b, &s.cmd, "i32"),
+        _f("joint", b, &s.joint, "i32"),
+        _f("axis", b, &s.axis, "i32"),
+        _f("ival", b, &s.ival, "i32"),
+        _f("index", b, &s.index, "i32"),
+        _f("id", b, &s.id, "i32"),
+        _f("motion_type", b, &s.motion_type, "i32"),
+        _f("turn", b, &s.turn, "i32"),
+        _f("vel", b, &s.vel, "f64"),
+        _f("ini_maxvel", b, &s.ini_maxvel, "f64"),
+        _f("acc", b, &s.acc, "f64"),
+        _f("jerk", b, &s.jerk, "f64"),
+        _f("offset", b, &s.offset, "f64"),
+        _f("value", b, &s.value, "f64"),
+        _f("min_limit", b, &s.min_limit, "f64"),
+        _f("max_limit", b, &s.max_limit, "f64"),
+        _f("tolerance", b, &s.tolerance, "f64"),
+        _f("comp", b, &s.comp, "f64", 3),
+        _f("pos", b, &s.pos, "EmcPose"),
+        _f("center", b, &s.center, "PmCartesian"),
+        _f("normal", b, &s.normal, "PmCartesian"),
+        _f("home_offset", b, &s.home_offset, "f64"),
+        _f("home", b, &s.home, "f64"),
+        _f("home_search_vel", b, &s.home_search_vel, "f64"),
+        _f("home_latch_vel", b, &s.home_latch_vel, "f64"),
+        _f("home_final_vel", b, &s.home_final_vel, "f64"),
+        _f("home_sequence", b, &s.home_sequence, "i32"),
+        _f("volatile_home", b, &s.volatile_home, "i32"),
+        _f("home_flags", b, &s.home_flags, "u32"),
+        _f("line", b, &s.line, "i32"),
+        _f("epoch", b, &s.epoch, "u32"),
+        _f("sync", b, &s.sync, "i32"),
+        _f("pitch", b, &s.pitch, "f64"),
+    )
+
+
+cdef tuple _layout_spindle_status():
+    cdef mot_spindle_status_t s
+    cdef void *b = &s
+    return sizeof(s), (
+        _f("speed", b, &s.speed, "f64"),
+        _f("speed_in", b, &s.speed_in, "f64"),
+        _f("revs", b, &s.revs, "f64"),
+        _f("orient_angle", b, &s.orient_angle, "f64"),
+        _f("css_factor", b, &s.css_factor, "f64"),
+        _f("on", b, &s.on, "i32"),
+        _f("direction", b, &s.direction, "i32"),
+        _f("brake", b, &s.brake, "i32"),
+        _f("locked", b, &s.locked, "i32"),
+        _f("orient_state", b, &s.orient_state, "i32"),
+        _f("orient_fault", b, &s.orient_fault, "i32"),
+        _f("at_speed", b, &s.at_speed, "i32"),
+        _f("inhibit", b, &s.inhibit, "i32"),
+        _f("amp_fault", b, &s.amp_fault, "i32"),
+    )
+
+
+cdef tuple _layout_joint_status():
+    cdef mot_joint_status_t s
+    cdef void *b = &s
+    return sizeof(s), (
+        _f("flags", b, &s.flags, "u32"),
+        _f("home_state", b, &s.home_state, "i32"),
+        _f("pos_cmd", b, &s.pos_cmd, "f64"),
+        _f("pos_fb", b, &s.pos_fb, "f64"),
+        _f("vel_cmd", b, &s.vel_cmd, "f64"),
+        _f("acc_cmd", b, &s.acc_cmd, "f64"),
+        _f("ferror", b, &s.ferror, "f64"),
+        _f("ferror_limit", b, &s.ferror_limit, "f64"),
+        _f("ferror_high_mark", b, &s.ferror_high_mark, "f64"),
+        _f("motor_offset", b, &s.motor_offset, "f64"),
+        _f("motor_pos_cmd", b, &s.motor_pos_cmd, "f64"),
+        _f("motor_pos_fb", b, &s.motor_pos_fb, "f64"),
+        _f("backlash_filt", b, &s.backlash_filt, "f64"),
+        _f("min_pos_limit", b, &s.min_pos_limit, "f64"),
+        _f("max_pos_limit", b, &s.max_pos_limit, "f64"),
+        _f("vel_limit", b, &s.vel_limit, "f64"),
+        _f("acc_limit", b, &s.acc_limit, "f64"),
+        _f("jerk_limit", b, &s.jerk_limit, "f64"),
+        _f("min_ferror", b, &s.min_ferror, "f64"),
+        _f("max_ferror", b, &s.max_ferror, "f64"),
+        _f("backlash", b, &s.backlash, "f64"),
+        _f("free_target", b, &s.free_target, "f64"),
+        _f("free_active", b, &s.free_active, "i32"),
+        _f("jog_active", b, &s.jog_active, "i32"),
+    )
+
+
+cdef tuple _layout_axis_status():
+    cdef mot_axis_status_t s
+    cdef void *b = &s
+    return sizeof(s), (
+        _f("pos_cmd", b, &s.pos_cmd, "f64"),
+        _f("vel_cmd", b, &s.vel_cmd, "f64"),
+        _f("teleop_pos", b, &s.teleop_pos, "f64"),
+        _f("teleop_vel", b, &s.teleop_vel, "f64"),
+        _f("teleop_target", b, &s.teleop_target, "f64"),
+        _f("min_pos_limit", b, &s.min_pos_limit, "f64"),
+        _f("max_pos_limit", b, &s.max_pos_limit, "f64"),
+        _f("vel_limit", b, &s.vel_limit, "f64"),
+        _f("acc_limit", b, &s.acc_limit, "f64"),
+        _f("jerk_limit", b, &s.jerk_limit, "f64"),
+        _f("teleop_active", b, &s.teleop_active, "i32"),
+        _f("jog_active", b, &s.jog_active, "i32"),
+    )
+
+
+cdef tuple _layout_status():
+    cdef mot_status_t s
+    cdef void *b = &s
+    return sizeof(s), (
+        _f("heartbeat", b, &s.heartbeat, "u64"),
+        _f("mode", b, &s.mode, "i32"),
+        _f("enabled", b, &s.enabled, "i32"),
+        _f("in_position", b, &s.in_position, "i32"),
+        _f("on_soft_limit", b, &s.on_soft_limit, "i32"),
+        _f("override_limits", b, &s.override_limits, "i32"),
+        _f("num_joints", b, &s.num_joints, "i32"),
+        _f("num_joints_loaded", b, &s.num_joints_loaded, "i32"),
+        _f("num_extrajoints", b, &s.num_extrajoints, "i32"),
+        _f("kins_type", b, &s.kins_type, "i32"),
+        _f("homing", b, &s.homing, "i32"),
+        _f("all_homed", b, &s.all_homed, "i32"),
+        _f("paused", b, &s.paused, "i32"),
+        _f("probing", b, &s.probing, "i32"),
+        _f("probe_tripped", b, &s.probe_tripped, "i32"),
+        _f("queue_depth", b, &s.queue_depth, "i32"),
+        _f("motion_id", b, &s.motion_id, "i32"),
+        _f("motion_type", b, &s.motion_type, "i32"),
+        _f("profile", b, &s.profile, "i32"),
+        _f("coord_error", b, &s.coord_error, "i32"),
+        _f("error", b, &s.error, "i32"),
+        _f("num_dio", b, &s.num_dio, "i32"),
+        _f("num_aio", b, &s.num_aio, "i32"),
+        _f("num_spindles", b, &s.num_spindles, "i32"),
+        _f("term_cond", b, &s.term_cond, "i32"),
+        _f("feed_scale", b, &s.feed_scale, "f64"),
+        _f("rapid_scale", b, &s.rapid_scale, "f64"),
+        _f("current_vel", b, &s.current_vel, "f64"),
+        _f("distance_to_go", b, &s.distance_to_go, "f64"),
+        _f("requested_vel", b, &s.requested_vel, "f64"),
+        _f("vel_limit", b, &s.vel_limit, "f64"),
+        _f("acc_limit", b, &s.acc_limit, "f64"),
+        _f("tolerance", b, &s.tolerance, "f64"),
+        _f("servo_period", b, &s.servo_period, "f64"),
+        _f("traj_period", b, &s.traj_period, "f64"),
+        _f("carte_pos_cmd", b, &s.carte_pos_cmd, "EmcPose"),
+        _f("carte_pos_fb", b, &s.carte_pos_fb, "EmcPose"),
+        _f("carte_pos_fb_ok", b, &s.carte_pos_fb_ok, "i32"),
+        _f("probed_pos", b, &s.probed_pos, "EmcPose"),
+        _f("tool_offset", b, &s.tool_offset, "EmcPose"),
+        _f("dout", b, &s.dout, "u64"),
+        _f("din", b, &s.din, "u64"),
+        _f("joint", b, &s.joint, "mot_joint_status_t", MOT_MAX_JOINTS),
+        _f("axis", b, &s.axis, "mot_axis_status_t", MOT_MAX_AXES),
+        _f("program_line", b, &s.program_line, "i32"),
+        _f("feed_hold_enabled", b, &s.feed_hold_enabled, "i32"),
+        _f("adaptive_enabled", b, &s.adaptive_enabled, "i32"),
+        _f("feed_hold", b, &s.feed_hold, "i32"),
+        _f("feed_inhibit", b, &s.feed_inhibit, "i32"),
+        _f("queue_taken", b, &s.queue_taken, "i32"),
+        _f("queue_err_count", b, &s.queue_err_count, "u32"),
+        _f("adaptive_feed", b, &s.adaptive_feed, "f64"),
+        _f("feed_upm", b, &s.feed_upm, "f64"),
+        _f("linear_units", b, &s.linear_units, "f64"),
+        _f("ain", b, &s.ain, "f64", MOT_MAX_AIO),
+        _f("aout", b, &s.aout, "f64", MOT_MAX_AIO),
+        _f("spindle", b, &s.spindle, "mot_spindle_status_t", MOT_MAX_SPINDLES),
+        _f("spindle_wait", b, &s.spindle_wait, "i32"),
+        _f("queue_held", b, &s.queue_held, "i32"),
+    )
+
+
+cdef tuple _layout_msg():
+    cdef mot_msg_t s
+    cdef void *b = &s
+    return sizeof(s), (
+        _f("n", b, &s.n, "u64"),
+        _f("text", b, &s.text, "char", MOT_MSG_LEN),
+    )
+
+
+cdef tuple _layout_channel():
+    # (the block holds the move queue: too large for the stack)
+    cdef mot_channel_t *s = <mot_channel_t *>calloc(1, sizeof(s[0]))
+    cdef void *b = s
+    if s == NULL:
+        raise MemoryError()
+    try:
+        return sizeof(s[0]), (
+            _f("magic", b, &s.magic, "u32"),
+            _f("version", b, &s.version, "u32"),
+            _f("size", b, &s.size, "u32"),
+            _f("lock_pid", b, &s.lock_pid, "i32"),
+            _f("cmd_seq", b, &s.cmd_seq, "u32"),
+            _f("echo_seq", b, &s.echo_seq, "u32"),
+            _f("echo_status", b, &s.echo_status, "i32"),
+            _f("echo_cmd", b, &s.echo_cmd, "i32"),
+            _f("echo_reason", b, &s.echo_reason, "char", MOT_REASON_LEN),
+            _f("command", b, &s.command, "mot_command_t"),
+            _f("status_seq", b, &s.status_seq, "u32"),
+            _f("status", b, &s.status, "mot_status_t"),
+            _f("msg_count", b, &s.msg_count, "u64"),
+            _f("msgs", b, &s.msgs, "mot_msg_t", MOT_MSG_RING),
+            _f("q_head", b, &s.q_head, "u32"),
+            _f("q_tail", b, &s.q_tail, "u32"),
+            _f("q_err_count", b, &s.q_err_count, "u32"),
+            _f("q_err_cmd", b, &s.q_err_cmd, "i32"),
+            _f("q_err_id", b, &s.q_err_id, "i32"),
+            _f("q_err_line", b, &s.q_err_line, "i32"),
+            _f("q_err_reason", b, &s.q_err_reason, "char", MOT_REASON_LEN),
+            _f("queue", b, &s.queue, "mot_command_t", MOT_QUEUE_SIZE),
+        )
+    finally:
+        free(s)
+
+
+LAYOUT = {"PmCartesian": _layout_PmCartesian(),
+          "EmcPose": _layout_EmcPose(),
+          "mot_command_t": _layout_command(),
+          "mot_spindle_status_t": _layout_spindle_status(),
+          "mot_joint_status_t": _layout_joint_status(),
+          "mot_axis_status_t": _layout_axis_status(),
+          "mot_status_t": _layout_status(),
+          "mot_msg_t": _layout_msg(),
+          "mot_channel_t": _layout_channel()}
 
 class ChannelError(Exception):
     """The block is missing, gone, or not a channel of this version."""
