@@ -22,8 +22,8 @@
 int mot_cmd_set_num_joints(mot_t *mot, const mot_command_t *c)
 {
     if (c->ival < 1 || c->ival > mot->num_joints)
-        return mot_reject(mot, "SET_NUM_JOINTS: %d is out of range (1..%d, the "
-                          "num_joints motmod was loaded with)", c->ival,
+        return mot_reject(mot, "SET_NUM_JOINTS: %d is out of range (1..%d, "
+                          "the num_joints motmod was loaded with)", c->ival,
                           mot->num_joints);
     if (mot->enabled)
         return mot_reject(mot, "SET_NUM_JOINTS needs motion disabled");
@@ -51,8 +51,8 @@ int mot_cmd_set_joint_vel_limit(mot_t *mot, const mot_command_t *c)
     int r;
     mot_joint_t *j;
 
-    if ((r = mot_bad_joint(mot, c->joint)) || (r = mot_bad_positive(mot, "velocity",
-                                                                    c->vel)))
+    if ((r = mot_bad_joint(mot, c->joint)) ||
+        (r = mot_bad_positive(mot, "velocity", c->vel)))
         return r;
     j = &mot->joints[c->joint];
     j->vel_limit = c->vel;
@@ -67,8 +67,8 @@ int mot_cmd_set_joint_acc_limit(mot_t *mot, const mot_command_t *c)
 {
     int r;
 
-    if ((r = mot_bad_joint(mot, c->joint)) || (r = mot_bad_positive(mot, "acceleration",
-                                                                    c->acc)))
+    if ((r = mot_bad_joint(mot, c->joint)) ||
+        (r = mot_bad_positive(mot, "acceleration", c->acc)))
         return r;
     mot->joints[c->joint].acc_limit = c->acc;
     mot_joint_limits_to_planner(mot, c->joint);
@@ -80,7 +80,8 @@ int mot_cmd_set_joint_jerk_limit(mot_t *mot, const mot_command_t *c)
 {
     int r;
 
-    if ((r = mot_bad_joint(mot, c->joint)) || (r = mot_bad_nonneg(mot, "jerk", c->jerk)))
+    if ((r = mot_bad_joint(mot, c->joint)) ||
+        (r = mot_bad_nonneg(mot, "jerk", c->jerk)))
         return r;
     if (mot->joints[c->joint].free_tp.active)
         return mot_reject(mot, "SET_JOINT_JERK_LIMIT: joint %d is moving",
@@ -113,8 +114,8 @@ int mot_cmd_set_joint_backlash(mot_t *mot, const mot_command_t *c)
     int r;
     char w[MOT_REASON_LEN];
 
-    if ((r = mot_bad_joint(mot, c->joint)) || (r = mot_bad_nonneg(mot, "backlash",
-                                                                  c->value)))
+    if ((r = mot_bad_joint(mot, c->joint)) ||
+        (r = mot_bad_nonneg(mot, "backlash", c->value)))
         return r;
     w[0] = 0;
     if (mot_comp_set_backlash(&mot->comp[c->joint], c->value, w,
@@ -153,8 +154,8 @@ int mot_cmd_set_joint_motor_offset(mot_t *mot, const mot_command_t *c)
 {
     int r;
 
-    if ((r = mot_bad_joint(mot, c->joint)) || (r = mot_bad_pos(mot, "motor offset",
-                                                               c->value)))
+    if ((r = mot_bad_joint(mot, c->joint)) ||
+        (r = mot_bad_pos(mot, "motor offset", c->value)))
         return r;
     if (mot->joints[c->joint].free_tp.active)
         return mot_reject(mot, "SET_JOINT_MOTOR_OFFSET: joint %d is moving",
@@ -183,8 +184,8 @@ int mot_cmd_set_axis_vel_limit(mot_t *mot, const mot_command_t *c)
     int r;
     mot_axis_t *a;
 
-    if ((r = mot_bad_axis(mot, c->axis)) || (r = mot_bad_positive(mot, "velocity",
-                                                                  c->vel)))
+    if ((r = mot_bad_axis(mot, c->axis)) ||
+        (r = mot_bad_positive(mot, "velocity", c->vel)))
         return r;
     a = &mot->axis[c->axis];
     a->vel_limit = c->vel;
@@ -199,8 +200,8 @@ int mot_cmd_set_axis_acc_limit(mot_t *mot, const mot_command_t *c)
     int r;
     mot_axis_t *a;
 
-    if ((r = mot_bad_axis(mot, c->axis)) || (r = mot_bad_positive(mot, "acceleration",
-                                                                  c->acc)))
+    if ((r = mot_bad_axis(mot, c->axis)) ||
+        (r = mot_bad_positive(mot, "acceleration", c->acc)))
         return r;
     a = &mot->axis[c->axis];
     a->acc_limit = c->acc;
@@ -214,7 +215,8 @@ int mot_cmd_set_axis_jerk_limit(mot_t *mot, const mot_command_t *c)
 {
     int r;
 
-    if ((r = mot_bad_axis(mot, c->axis)) || (r = mot_bad_nonneg(mot, "jerk", c->jerk)))
+    if ((r = mot_bad_axis(mot, c->axis)) ||
+        (r = mot_bad_nonneg(mot, "jerk", c->jerk)))
         return r;
     if (mot->axis[c->axis].tp.active)
         return mot_reject(mot, "SET_AXIS_JERK_LIMIT: axis %c is moving",
@@ -232,8 +234,8 @@ int mot_cmd_set_profile(mot_t *mot, const mot_command_t *c)
     int i;
 
     if (c->ival != FP_TRAPEZOID && c->ival != FP_JERK)
-        return mot_reject(mot, "SET_PROFILE: %d is not a profile (0 trapezoid, "
-                          "1 jerk-limited)", c->ival);
+        return mot_reject(mot, "SET_PROFILE: %d is not a profile (0 "
+                          "trapezoid, 1 jerk-limited)", c->ival);
     if (mot_moving(mot))
         return mot_reject(mot, "SET_PROFILE: cannot change the profile while "
                           "the machine moves");

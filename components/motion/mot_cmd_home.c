@@ -22,24 +22,26 @@ int mot_cmd_home(mot_t *mot, const mot_command_t *c)
     char w[MOT_REASON_LEN];
 
     if (mot->mode != MOT_MODE_FREE)
-        return mot_reject(mot, "HOME needs free mode (now %s)", mot_mode_names[mot->mode]);
+        return mot_reject(mot, "HOME needs free mode (now %s)",
+                          mot_mode_names[mot->mode]);
     if (!mot->enabled)
         return mot_reject(mot, "HOME needs motion enabled");
     if (*mot->mp->homing_inhibit)
-        return mot_reject(mot, "HOME: homing is inhibited (motion.homing-inhibit is "
-                          "true)");
+        return mot_reject(mot, "HOME: homing is inhibited "
+                          "(motion.homing-inhibit is true)");
     if (c->joint != -1 && (r = mot_bad_joint(mot, c->joint)))
         return r;
     for (i = 0; i < mot->num_joints_used; i++) {
         if ((c->joint == -1 || c->joint == i)
             && mot->joints[i].free_tp.active && !mot->home->is_homing(i))
-            return mot_reject(mot, "HOME: joint %d is moving (wait until it stops)",
-                              i);
+            return mot_reject(mot, "HOME: joint %d is moving (wait until it "
+                              "stops)", i);
     }
     w[0] = 0;
     r = mot->home->start(c->joint, w, sizeof(w));
     if (r < 0)
-        return mot_reject(mot, "HOME: %s", w[0] ? w : "the homing module refused");
+        return mot_reject(mot, "HOME: %s",
+                          w[0] ? w : "the homing module refused");
     return MOT_ECHO_ACCEPTED;
 }
 
@@ -49,8 +51,8 @@ int mot_cmd_unhome(mot_t *mot, const mot_command_t *c)
     char w[MOT_REASON_LEN];
 
     if (c->joint < -2)
-        return mot_reject(mot, "UNHOME: joint %d is neither a joint nor -1 (all) or "
-                          "-2 (volatile ones)", c->joint);
+        return mot_reject(mot, "UNHOME: joint %d is neither a joint nor -1 "
+                          "(all) or -2 (volatile ones)", c->joint);
     if (c->joint >= 0 && (r = mot_bad_joint(mot, c->joint)))
         return r;
     if (mot->mode != MOT_MODE_FREE && c->joint != -2)
@@ -63,13 +65,14 @@ int mot_cmd_unhome(mot_t *mot, const mot_command_t *c)
         for (i = mot->num_joints - mot->num_extra; i < mot->num_joints;
              i++)
             if ((c->joint == i || c->joint == -1) && mot->home->is_homed(i))
-                return mot_reject(mot, "UNHOME: extra joint %d can be unhomed only "
-                                  "while motion is disabled", i);
+                return mot_reject(mot, "UNHOME: extra joint %d can be "
+                                  "unhomed only while motion is disabled", i);
     }
     w[0] = 0;
     r = mot->home->unhome(c->joint, w, sizeof(w));
     if (r < 0)
-        return mot_reject(mot, "UNHOME: %s", w[0] ? w : "the homing module refused");
+        return mot_reject(mot, "UNHOME: %s",
+                          w[0] ? w : "the homing module refused");
     return MOT_ECHO_DONE;
 }
 

@@ -52,8 +52,8 @@ static int cmd_jog_joint(mot_t *mot, const mot_command_t *c)
     if (mot_any_homing(mot))
         return mot_reject(mot, "%s: cannot jog while a joint is homing", name);
     if (*mot->mp->jog_inhibit)
-        return mot_reject(mot, "%s: jogging is inhibited (motion.jog-inhibit is "
-                          "true)", name);
+        return mot_reject(mot, "%s: jogging is inhibited (motion.jog-inhibit "
+                          "is true)", name);
     if (!(j->flags & MOT_JOINT_ACTIVE))
         return mot_reject(mot, "%s: joint %d is not active", name, n);
     if (mot->home_seq[n] < 0 && mot->home_seq[n] != HOME_SEQUENCE_NONE)
@@ -87,11 +87,11 @@ static int cmd_jog_joint(mot_t *mot, const mot_command_t *c)
     }
     if (homed) {
         if (dir > 0 && j->pos_cmd >= j->max_pos_limit)
-            return mot_reject(mot, "%s: joint %d is at its positive soft limit "
-                              "(%g)", name, n, j->max_pos_limit);
+            return mot_reject(mot, "%s: joint %d is at its positive soft "
+                              "limit (%g)", name, n, j->max_pos_limit);
         if (dir < 0 && j->pos_cmd <= j->min_pos_limit)
-            return mot_reject(mot, "%s: joint %d is at its negative soft limit "
-                              "(%g)", name, n, j->min_pos_limit);
+            return mot_reject(mot, "%s: joint %d is at its negative soft "
+                              "limit (%g)", name, n, j->min_pos_limit);
         if (t > j->max_pos_limit)
             t = j->max_pos_limit;
         if (t < j->min_pos_limit)
@@ -100,11 +100,11 @@ static int cmd_jog_joint(mot_t *mot, const mot_command_t *c)
     /* a limit switch already hit (while limits are overridden): only
        away from it */
     if (dir > 0 && j->pos_limit_sw)
-        return mot_reject(mot, "%s: joint %d is on its positive hard limit switch",
-                          name, n);
+        return mot_reject(mot, "%s: joint %d is on its positive hard limit "
+                          "switch", name, n);
     if (dir < 0 && j->neg_limit_sw)
-        return mot_reject(mot, "%s: joint %d is on its negative hard limit switch",
-                          name, n);
+        return mot_reject(mot, "%s: joint %d is on its negative hard limit "
+                          "switch", name, n);
     spd = jog_speed(mot, c->vel, j->vel_limit);
     if (!(spd > 0))
         return mot_reject(mot, "%s: the jog speed is 0 (feed scale %g)", name,
@@ -146,8 +146,8 @@ static int cmd_jog_axis(mot_t *mot, const mot_command_t *c)
     double t, spd, dir, pos;
 
     if (mot->mode != MOT_MODE_TELEOP)
-        return mot_reject(mot, "%s of an axis needs teleop mode (now %s)", name,
-                          mot_mode_names[mot->mode]);
+        return mot_reject(mot, "%s of an axis needs teleop mode (now %s)",
+                          name, mot_mode_names[mot->mode]);
     if ((r = mot_bad_axis(mot, n)))
         return r;
     a = &mot->axis[n];
@@ -158,8 +158,8 @@ static int cmd_jog_axis(mot_t *mot, const mot_command_t *c)
     if (!mot->enabled)
         return mot_reject(mot, "%s needs motion enabled", name);
     if (*mot->mp->jog_inhibit)
-        return mot_reject(mot, "%s: jogging is inhibited (motion.jog-inhibit is "
-                          "true)", name);
+        return mot_reject(mot, "%s: jogging is inhibited (motion.jog-inhibit "
+                          "is true)", name);
     pos = a->tp.pos;
     if (c->cmd == MOT_CMD_JOG_CONT) {
         if (!isfinite(c->vel) || c->vel == 0)
@@ -214,10 +214,10 @@ int mot_cmd_jog(mot_t *mot, const mot_command_t *c)
     if (c->joint == -1 && c->axis >= 0)
         return cmd_jog_axis(mot, c);
     if (c->joint < -1)
-        return mot_reject(mot, "joint %d does not exist (num_joints=%d)", c->joint,
-                          mot->num_joints_used);
-    return mot_reject(mot, "%s needs a joint (free mode) or an axis with joint "
-                      "-1 (teleop mode)", mot_cmd_name(c->cmd));
+        return mot_reject(mot, "joint %d does not exist (num_joints=%d)",
+                          c->joint, mot->num_joints_used);
+    return mot_reject(mot, "%s needs a joint (free mode) or an axis with "
+                      "joint -1 (teleop mode)", mot_cmd_name(c->cmd));
 }
 
 int mot_cmd_teleop_vector(mot_t *mot, const mot_command_t *c)
@@ -240,7 +240,8 @@ int mot_cmd_teleop_vector(mot_t *mot, const mot_command_t *c)
         }
         mot_axis_limits_to_planner(mot, i);
         a->tp.max_vel = jog_speed(mot, v, a->vel_limit);
-        a->tp.target = axis_clamp(mot, i, a->tp.pos + (v > 0 ? MOT_FAR : -MOT_FAR),
+        a->tp.target = axis_clamp(mot, i,
+                                  a->tp.pos + (v > 0 ? MOT_FAR : -MOT_FAR),
                                   &lim);
         a->tp.enable = 1;
         a->jog = MOT_JOG_NONE;

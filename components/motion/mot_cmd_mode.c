@@ -35,24 +35,27 @@ int mot_cmd_mode(mot_t *mot, const mot_command_t *c)
     if (mot->mode == want)
         return MOT_ECHO_DONE;
     if (mot_any_homing(mot))
-        return mot_reject(mot, "%s: cannot change mode while a joint is homing",
-                          mot_cmd_name(c->cmd));
+        return mot_reject(mot, "%s: cannot change mode while a joint is "
+                          "homing", mot_cmd_name(c->cmd));
     if (mot_moving(mot)) {
         j = first_moving(mot);
         if (j >= 0)
-            return mot_reject(mot, "%s: cannot change mode while joint %d moves "
-                              "(now %s)", mot_cmd_name(c->cmd), j,
+            return mot_reject(mot, "%s: cannot change mode while joint %d "
+                              "moves (now %s)", mot_cmd_name(c->cmd), j,
                               mot_mode_names[mot->mode]);
-        return mot_reject(mot, "%s: cannot change mode while the machine moves "
-                          "(now %s)", mot_cmd_name(c->cmd), mot_mode_names[mot->mode]);
+        return mot_reject(mot, "%s: cannot change mode while the machine "
+                          "moves (now %s)", mot_cmd_name(c->cmd),
+                          mot_mode_names[mot->mode]);
     }
     if (want != MOT_MODE_FREE) {
         if (mot->kins_type != KINEMATICS_IDENTITY && !mot_all_homed(mot))
-            return mot_reject(mot, "%s needs all joints homed (the kinematics are "
-                              "not identity)", mot_cmd_name(c->cmd));
+            return mot_reject(mot, "%s needs all joints homed (the "
+                              "kinematics are not identity)",
+                              mot_cmd_name(c->cmd));
         if (mot->kins_type == KINEMATICS_FORWARD_ONLY)
-            return mot_reject(mot, "%s needs inverse kinematics (the kinematics "
-                              "module has forward only)", mot_cmd_name(c->cmd));
+            return mot_reject(mot, "%s needs inverse kinematics (the "
+                              "kinematics module has forward only)",
+                              mot_cmd_name(c->cmd));
     }
     mot_sync_planners(mot);
     if (want == MOT_MODE_COORD) {
@@ -166,7 +169,8 @@ int mot_cmd_deactivate_joint(mot_t *mot, const mot_command_t *c)
     if ((r = mot_bad_joint(mot, c->joint)))
         return r;
     if (mot->joints[c->joint].free_tp.active)
-        return mot_reject(mot, "DEACTIVATE_JOINT: joint %d is moving", c->joint);
+        return mot_reject(mot, "DEACTIVATE_JOINT: joint %d is moving",
+                          c->joint);
     mot->joints[c->joint].flags &= ~MOT_JOINT_ACTIVE;
     return MOT_ECHO_DONE;
 }

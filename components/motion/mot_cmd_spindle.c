@@ -54,12 +54,12 @@ int mot_cmd_spindle(mot_t *mot, const mot_command_t *c)
                 || (r = mot_bad_nonneg(mot, "CSS maximum speed", c->offset)))
                 return r;
             if (c->ival < 0 || c->ival >= MOT_MAX_AXES)
-                return mot_reject(mot, "SPINDLE_ON: CSS axis %d does not exist (axes "
-                                  "are 0..8 for X..W)", c->ival);
+                return mot_reject(mot, "SPINDLE_ON: CSS axis %d does not "
+                                  "exist (axes are 0..8 for X..W)", c->ival);
         }
         if (*mot->sp[n].amp_fault_in)
-            return mot_reject(mot, "SPINDLE_ON: spindle %d has an amplifier fault "
-                              "(spindle.%d.amp-fault-in is true)", n, n);
+            return mot_reject(mot, "SPINDLE_ON: spindle %d has an amplifier "
+                              "fault (spindle.%d.amp-fault-in is true)", n, n);
         sp->speed = c->vel;
         sp->css_factor = c->value;
         sp->css_axis = c->ival;
@@ -92,8 +92,8 @@ int mot_cmd_spindle(mot_t *mot, const mot_command_t *c)
         step = c->value > 0 ? c->value : 0.1 * fabs(sp->speed);
         if (c->cmd == MOT_CMD_SPINDLE_DECREASE) {
             if (step >= fabs(sp->speed))
-                return mot_reject(mot, "SPINDLE_DECREASE: a step of %g rpm would "
-                                  "stop spindle %d (now %g rpm); use "
+                return mot_reject(mot, "SPINDLE_DECREASE: a step of %g rpm "
+                                  "would stop spindle %d (now %g rpm); use "
                                   "SPINDLE_OFF", step, n, sp->speed);
             step = -step;
         }
@@ -118,8 +118,9 @@ int mot_cmd_spindle(mot_t *mot, const mot_command_t *c)
 
     case MOT_CMD_SPINDLE_BRAKE_ENGAGE:
         if (sp->on && sp->speed != 0)
-            return mot_reject(mot, "SPINDLE_BRAKE_ENGAGE: spindle %d turns (%g rpm); "
-                              "send SPINDLE_OFF first", n, sp->speed);
+            return mot_reject(mot, "SPINDLE_BRAKE_ENGAGE: spindle %d turns "
+                              "(%g rpm); send SPINDLE_OFF first", n,
+                              sp->speed);
         sp->brake = 1;
         return MOT_ECHO_DONE;
 

@@ -52,8 +52,8 @@ static int move_args(mot_t *mot, const mot_command_t *c, tp_move_t *m)
         if ((r = mot_bad_positive(mot, "pitch", c->pitch)))
             return r;
         if (!mot->spindle[n].on || mot->spindle[n].speed == 0)
-            return mot_reject(mot, "%s needs spindle %d turning (SPINDLE_ON first)",
-                              name, n);
+            return mot_reject(mot, "%s needs spindle %d turning (SPINDLE_ON "
+                              "first)", name, n);
         m->sync = TP_SYNC_POSITION;
         m->spindle = n;
         m->pitch = c->pitch;
@@ -62,15 +62,17 @@ static int move_args(mot_t *mot, const mot_command_t *c, tp_move_t *m)
         m->ini_maxvel = mot->vel_limit;
     if (m->acc == 0)
         m->acc = mot->acc_limit;
-    if ((r = mot_bad_positive(mot, "maximum velocity (ini_maxvel, or SET_VEL_LIMIT "
-                              "when 0)", m->ini_maxvel)))
+    if ((r = mot_bad_positive(mot, "maximum velocity (ini_maxvel, or "
+                              "SET_VEL_LIMIT when 0)", m->ini_maxvel)))
         return r;
-    if ((r = mot_bad_positive(mot, "acceleration (acc, or SET_ACC when 0)", m->acc)))
+    if ((r = mot_bad_positive(mot, "acceleration (acc, or SET_ACC when 0)",
+                              m->acc)))
         return r;
     if ((r = mot_bad_nonneg(mot, "jerk", m->jerk)))
         return r;
     if (c->motion_type < 0 || c->motion_type > MOT_MOTION_INDEXROTARY)
-        return mot_reject(mot, "motion type %d is not one of 0..6", c->motion_type);
+        return mot_reject(mot, "motion type %d is not one of 0..6",
+                          c->motion_type);
     /* the end point must be inside the axes' limits (when they apply) */
     if (mot->all_homed_c) {
         int i;
@@ -78,9 +80,10 @@ static int move_args(mot_t *mot, const mot_command_t *c, tp_move_t *m)
             mot_axis_t *a = &mot->axis[i];
             double v = *emcpose_axis((EmcPose *)&c->pos, i);
             if (v > a->max_pos_limit || v < a->min_pos_limit)
-                return mot_reject(mot, "%s: the end point %c=%g is outside the axis "
-                              "limits %g..%g", name, mot_axis_letters[i], v,
-                              a->min_pos_limit, a->max_pos_limit);
+                return mot_reject(mot, "%s: the end point %c=%g is outside "
+                                  "the axis limits %g..%g", name,
+                                  mot_axis_letters[i], v, a->min_pos_limit,
+                                  a->max_pos_limit);
         }
     }
     return 0;
@@ -99,7 +102,8 @@ int mot_check_move(mot_t *mot, const mot_command_t *c, tp_move_t *m)
         if ((r = mot_bad_cart(mot, "normal", &c->normal)))
             return r;
         if (c->normal.x == 0 && c->normal.y == 0 && c->normal.z == 0)
-            return mot_reject(mot, "SET_CIRCLE: the normal must not be (0, 0, 0)");
+            return mot_reject(mot, "SET_CIRCLE: the normal must not be (0, "
+                              "0, 0)");
     } else if (c->cmd == MOT_CMD_PROBE && mot->probe_tripped) {
         return mot_reject(mot, "PROBE: the probe flag is still set (send "
                           "CLEAR_PROBE_FLAG first)");

@@ -122,7 +122,8 @@ int mot_bad_joint(mot_t *mot, int j)
 int mot_bad_axis(mot_t *mot, int a)
 {
     if (a < 0 || a >= MOT_MAX_AXES)
-        return mot_reject(mot, "axis %d does not exist (axes are 0..8 for X..W)", a);
+        return mot_reject(mot, "axis %d does not exist (axes are 0..8 for "
+                          "X..W)", a);
     return 0;
 }
 
@@ -136,15 +137,16 @@ int mot_bad_pos(mot_t *mot, const char *what, double v)
 int mot_bad_positive(mot_t *mot, const char *what, double v)
 {
     if (!isfinite(v) || v <= 0)
-        return mot_reject(mot, "%s must be a positive number, got %g", what, v);
+        return mot_reject(mot, "%s must be a positive number, got %g", what,
+                          v);
     return 0;
 }
 
 int mot_bad_nonneg(mot_t *mot, const char *what, double v)
 {
     if (!isfinite(v) || v < 0)
-        return mot_reject(mot, "%s must be zero or a positive number, got %g", what,
-                          v);
+        return mot_reject(mot, "%s must be zero or a positive number, got %g",
+                          what, v);
     return 0;
 }
 
@@ -154,8 +156,8 @@ int mot_bad_pose(mot_t *mot, const char *what, const EmcPose *p)
     for (i = 0; i < MOT_MAX_AXES; i++) {
         double v = *emcpose_axis((EmcPose *)p, i);
         if (!isfinite(v))
-            return mot_reject(mot, "%s %c must be a finite number, got %g", what,
-                              mot_axis_letters[i], v);
+            return mot_reject(mot, "%s %c must be a finite number, got %g",
+                              what, mot_axis_letters[i], v);
     }
     return 0;
 }
@@ -163,8 +165,8 @@ int mot_bad_pose(mot_t *mot, const char *what, const EmcPose *p)
 int mot_bad_cart(mot_t *mot, const char *what, const PmCartesian *c)
 {
     if (!isfinite(c->x) || !isfinite(c->y) || !isfinite(c->z))
-        return mot_reject(mot, "%s must be finite numbers, got (%g, %g, %g)", what,
-                          c->x, c->y, c->z);
+        return mot_reject(mot, "%s must be finite numbers, got (%g, %g, %g)",
+                          what, c->x, c->y, c->z);
     return 0;
 }
 
@@ -181,8 +183,8 @@ int mot_any_homing(mot_t *mot)
 int mot_bad_spindle(mot_t *mot, int n)
 {
     if (n < 0 || n >= mot->num_spindles)
-        return mot_reject(mot, "spindle %d does not exist (num_spindles=%d)", n,
-                          mot->num_spindles);
+        return mot_reject(mot, "spindle %d does not exist (num_spindles=%d)",
+                          n, mot->num_spindles);
     return 0;
 }
 
@@ -196,8 +198,8 @@ int mot_bad_limits(mot_t *mot, const mot_command_t *c)
         || (r = mot_bad_pos(mot, "max_limit", c->max_limit)))
         return r;
     if (c->min_limit > c->max_limit)
-        return mot_reject(mot, "min_limit (%g) must not be above max_limit (%g)",
-                          c->min_limit, c->max_limit);
+        return mot_reject(mot, "min_limit (%g) must not be above max_limit "
+                          "(%g)", c->min_limit, c->max_limit);
     return 0;
 }
 
@@ -279,8 +281,8 @@ static int run_command(mot_t *mot, const mot_command_t *c)
     if (fn)
         return fn(mot, c);
     if (c->cmd >= MOT_CMD_RESERVED_FIRST && c->cmd <= MOT_CMD_RESERVED_LAST)
-        return mot_reject(mot, "command %d is reserved and not implemented yet",
-                          c->cmd);
+        return mot_reject(mot, "command %d is reserved and not implemented "
+                          "yet", c->cmd);
     return mot_reject(mot, "unknown command code %d", c->cmd);
 }
 
@@ -407,8 +409,9 @@ static void drain_queue(mot_t *mot, mot_channel_t *ch)
         if (queueable(c.cmd))
             st = run_command(mot, &c);
         else
-            st = mot_reject(mot, "%s cannot be queued (only moves and what must "
-                            "keep its order with them)", mot_cmd_name(c.cmd));
+            st = mot_reject(mot, "%s cannot be queued (only moves and what "
+                            "must keep its order with them)",
+                            mot_cmd_name(c.cmd));
         tail++;
         n++;
         if (st == MOT_ECHO_REJECTED) {
@@ -475,8 +478,8 @@ void mot_command_handler(void *arg, long period)
            get through meanwhile) and hold the move */
         tp_move_t m;
         if (mot->deferred_valid)
-            st = mot_reject(mot, "%s: a feed move already waits for the spindle to "
-                            "reach speed", mot_cmd_name(c.cmd));
+            st = mot_reject(mot, "%s: a feed move already waits for the "
+                            "spindle to reach speed", mot_cmd_name(c.cmd));
         else if ((st = mot_check_move(mot, &c, &m)) == MOT_ECHO_REJECTED)
             ;                           /* checked now, not after the wait */
         else {

@@ -336,7 +336,8 @@ static int check_faults(mot_t *mot)
     }
     for (i = 0; i < mot->num_misc; i++) {
         if (*mp->misc_error[i]) {
-            mot_post(mot, "motion.misc-error-%02d is true: motion disabled", i);
+            mot_post(mot, "motion.misc-error-%02d is true: motion disabled",
+                     i);
             fault(mot);
             return 1;
         }
@@ -740,8 +741,8 @@ static void run_coord(mot_t *mot, double dt)
                 /* (the end points were checked against the axis limits;
                    this catches joint limits of non-trivial kinematics)
                    stop here, once: a fault */
-                mot_post(mot, "coord move would take joint %d past its %s soft "
-                         "limit: motion disabled", i,
+                mot_post(mot, "coord move would take joint %d past its %s "
+                         "soft limit: motion disabled", i,
                          jt[i] > j->max_pos_limit ? "positive" : "negative");
                 mot->coarse_next = mot->coarse_prev;
                 fault(mot);
@@ -829,16 +830,17 @@ static void run_spindles(mot_t *mot)
            while it is true */
         sp->amp_fault = *p->amp_fault_in ? 1 : 0;
         if (sp->amp_fault && mot->enabled) {
-            mot_post(mot, "spindle %d amplifier fault (spindle.%d.amp-fault-in): "
-                     "motion disabled", n, n);
+            mot_post(mot, "spindle %d amplifier fault "
+                     "(spindle.%d.amp-fault-in): motion disabled", n, n);
             fault(mot);
         }
         if (sp->orient_state == MOT_ORIENT_RUNNING) {
             if (*p->orient_fault != 0) {
                 sp->orient_fault = *p->orient_fault;
                 sp->orient_state = MOT_ORIENT_FAULT;
-                mot_post(mot, "spindle %d orient failed: spindle.%d.orient-fault "
-                         "is %d", n, n, sp->orient_fault);
+                mot_post(mot, "spindle %d orient failed: "
+                         "spindle.%d.orient-fault is %d", n, n,
+                         sp->orient_fault);
             } else if (*p->is_oriented) {
                 sp->orient_state = MOT_ORIENT_DONE;
                 sp->brake = 1;
