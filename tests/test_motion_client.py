@@ -21,6 +21,8 @@ import pytest
 from halsdk.core import _core
 from halsdk.errors import HalError
 from halsdk.motion import (
+    HOME_SEQUENCE_NONE,
+    HomeFlag,
     Mode,
     Motion,
     MotionError,
@@ -446,8 +448,9 @@ def test_homing_keys_map_to_fields():
                        "HOME_ABSOLUTE_ENCODER": 2, "VOLATILE_HOME": 1})
     assert f["home_search_vel"] == -2.5 and f["home_latch_vel"] == 0.5
     assert f["home_sequence"] == -1 and f["volatile_home"] == 1
-    assert f["home_flags"] == 0x0002 | 0x0010 | 0x0040
-    assert homing_fields({})["home_sequence"] == -1000   # not set
+    assert f["home_flags"] == (HomeFlag.USE_INDEX | HomeFlag.ABSOLUTE_ENCODER
+                               | HomeFlag.NO_FINAL_MOVE)
+    assert homing_fields({})["home_sequence"] == HOME_SEQUENCE_NONE
     with pytest.raises(ValueError, match="HOME_ABSOLUTE_ENCODER"):
         homing_fields({"HOME_ABSOLUTE_ENCODER": 3})
     with pytest.raises(ValueError, match="HOME_BOGUS"):

@@ -1,6 +1,6 @@
 """Backlash and lead-screw compensation of the motion controller
 (components/motion/mot_comp.c, through ctypes from a library built here)
-and the compensation file reader (halsdk.motion.compfile)."""
+and the compensation file reader (halsdk.motion.screwcomp)."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ import pytest
 from test_motion_freeplan import DPTR, Freeplan, build_library
 
 from halsdk.errors import HalError
-from halsdk.motion.compfile import (
+from halsdk.motion.screwcomp import (
     COMP_SIZE,
     CompFileError,
     parse_comp,
@@ -402,7 +402,7 @@ def test_too_many_entries_and_other_errors(tmp_path):
 
 
 def test_file_into_the_realtime_table(lib, tmp_path):
-    """A file read by compfile goes into mot_comp entry by entry and the
+    """A file read by screwcomp goes into mot_comp entry by entry and the
     lookup reproduces its trims."""
     rng = np.random.default_rng(8)
     nom = np.cumsum(rng.uniform(0.1, 5, size=40)) - 50

@@ -22,26 +22,28 @@ import pytest
 
 import halsdk
 from halsdk.core import _core
+from halsdk.motion import HOME_SEQUENCE_NONE, HomeFlag, JointFlag
 
 DT = 0.001
 PERIOD_NS = 1_000_000
 INDEX_PITCH = 1.0           # motor units between index marks
 INDEX_PHASE = 0.37          # first mark at this motor position (mod pitch)
 
-HOME_IGNORE_LIMITS = 0x0001
-HOME_USE_INDEX = 0x0002
-HOME_IS_SHARED = 0x0004
-HOME_ABSOLUTE_ENCODER = 0x0010
-HOME_NO_REHOME = 0x0020
-HOME_NO_FINAL_MOVE = 0x0040
-HOME_INDEX_NO_ENCODER_RESET = 0x0080
+# the protocol's numbers, from the compiled headers (never typed here)
+HOME_IGNORE_LIMITS = HomeFlag.IGNORE_LIMITS
+HOME_USE_INDEX = HomeFlag.USE_INDEX
+HOME_IS_SHARED = HomeFlag.IS_SHARED
+HOME_ABSOLUTE_ENCODER = HomeFlag.ABSOLUTE_ENCODER
+HOME_NO_REHOME = HomeFlag.NO_REHOME
+HOME_NO_FINAL_MOVE = HomeFlag.NO_FINAL_MOVE
+HOME_INDEX_NO_ENCODER_RESET = HomeFlag.INDEX_NO_ENCODER_RESET
 
-# home_sequence of a joint that is not in "home all" (homing.h)
-SEQ_NONE = -1000       # HOME_SEQUENCE_NONE of homing.h: key absent
+# home_sequence of a joint that is not in "home all": key absent
+SEQ_NONE = HOME_SEQUENCE_NONE
 
-MOT_JOINT_ACTIVE = 0x0001
-MOT_JOINT_HOMING = 0x0400
-MOT_JOINT_HOMED = 0x0800
+MOT_JOINT_ACTIVE = JointFlag.ACTIVE
+MOT_JOINT_HOMING = JointFlag.HOMING
+MOT_JOINT_HOMED = JointFlag.HOMED
 
 # home-state numbers of homemod (docs/homing.rst)
 HS_IDLE, HS_LATCH, HS_INDEX, HS_SYNC, HS_FINAL = 0, 8, 9, 11, 12

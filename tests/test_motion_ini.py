@@ -9,7 +9,7 @@ import re
 import pytest
 
 from halsdk.motion import Motion, MotionIniError, read_motion_ini
-from halsdk.motion.compfile import CompFileError
+from halsdk.motion.screwcomp import CompFileError
 
 EXAMPLE = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(
     __file__))), "examples", "motion", "mill3.ini")

@@ -92,15 +92,22 @@ typedef struct {
 } home_joint_t;
 
 static int comp_id = -1;        /* homemod's own component */
-static int nj;                  /* joints (extra ones included) */
-static double dt;               /* servo period, s */
-static mot_joint_t *J;          /* motmod's joint array */
-static home_joint_t *H;         /* hal_malloc'd, nj */
-static home_pins_t *P;          /* hal_malloc'd, nj */
+/* the state of the module: one home_t, handed to every function below.
+   The functions of the homing.h table (hm_*) carry no context: motmod
+   calls them as a custom homing module's would be called, so each of them
+   takes the module's one home_t (homing) and hands it on */
+typedef struct {
+    int nj;                     /* joints (extra ones included) */
+    double dt;                  /* servo period, s */
+    mot_joint_t *J;             /* motmod's joint array */
+    home_joint_t *H;            /* hal_malloc'd, nj */
+    home_pins_t *P;             /* hal_malloc'd, nj */
+    int all_seq;                /* home all: sequence running, -1: none */
+    char errbuf[256];           /* failures not yet taken */
+    char errout[256];           /* the text take_error() handed out */
+} home_t;
 
-static int all_seq = -1;        /* home all: sequence running, -1: none */
-static char errbuf[256];        /* failures not yet taken */
-static char errout[256];        /* the text take_error() handed out */
+static home_t homing = {.all_seq = -1};
 
 /* ---- small helpers ---- */
 
@@ -117,94 +124,97 @@ static void why_set(char *why, int whylen, const char *fmt, ...)
 }
 
 /* remember a failure for take_error(); several in one cycle are joined */
-static void post(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
-static void post(const char *fmt, ...)
+static void post(home_t *home, const char *fmt, ...)
+    __attribute__((format(printf, 2, 3)));
+static void post(home_t *home, const char *fmt, ...)
 {
     va_list ap;
-    size_t n = strlen(errbuf);
-    if (n > 0 && n + 2 < sizeof(errbuf)) {
-        strcpy(errbuf + n, "; ");
+    size_t n = strlen(home->errbuf);
+    if (n > 0 && n + 2 < sizeof(home->errbuf)) {
+        strcpy(home->errbuf + n, "; ");
         n += 2;
     }
-    if (n + 1 >= sizeof(errbuf))
+    if (n + 1 >= sizeof(home->errbuf))
         return;
     va_start(ap, fmt);
-    vsnprintf(errbuf + n, sizeof(errbuf) - n, fmt, ap);
+    vsnprintf(home->errbuf + n, sizeof(home->errbuf) - n, fmt, ap);
     va_end(ap);
 }
 
-static int bad_joint(int j, char *why, int whylen)
+static int bad_joint(const home_t *home, int j, char *why, int whylen)
 {
-    if (!J) {
+    if (!home->J) {
         why_set(why, whylen, "homing is not initialized (motmod not loaded)");
         return 1;
     }
-    if (j < 0 || j >= nj) {
-        why_set(why, whylen, "joint %d does not exist (num_joints=%d)", j, nj);
+    if (j < 0 || j >= home->nj) {
+        why_set(why, whylen, "joint %d does not exist (num_joints=%d)", j,
+                home->nj);
         return 1;
     }
     return 0;
 }
 
-static int seq_set(int j)
+static int seq_set(const home_t *home, int j)
 {
-    return H[j].p.home_sequence != SEQ_NONE;
+    return home->H[j].p.home_sequence != SEQ_NONE;
 }
 
-static int seq_abs(int j)
+static int seq_abs(const home_t *home, int j)
 {
-    int s = H[j].p.home_sequence;
+    int s = home->H[j].p.home_sequence;
     return s < 0 ? -s : s;
 }
 
 /* a group (|sequence|) is synchronized when any member is negative */
-static int group_sync(int g)
+static int group_sync(const home_t *home, int g)
 {
     int k;
-    for (k = 0; k < nj; k++)
-        if (seq_set(k) && seq_abs(k) == g && H[k].p.home_sequence < 0)
+    for (k = 0; k < home->nj; k++)
+        if (seq_set(home, k) && seq_abs(home, k) == g &&
+            home->H[k].p.home_sequence < 0)
             return 1;
     return 0;
 }
 
-static int abs_mode(int j)
+static int abs_mode(const home_t *home, int j)
 {
-    if (!(H[j].p.flags & HOME_ABSOLUTE_ENCODER))
+    if (!(home->H[j].p.flags & HOME_ABSOLUTE_ENCODER))
         return 0;
-    return (H[j].p.flags & HOME_NO_FINAL_MOVE) ? 2 : 1;
+    return (home->H[j].p.flags & HOME_NO_FINAL_MOVE) ? 2 : 1;
 }
 
-static double travel(int j)
+static double travel(const home_t *home, int j)
 {
-    double t = J[j].max_pos_limit - J[j].min_pos_limit;
+    double t = home->J[j].max_pos_limit - home->J[j].min_pos_limit;
     return (isfinite(t) && t > 0) ? t : 0;
 }
 
 /* a speed limited by the joint's velocity limit */
-static double speed(int j, double v)
+static double speed(const home_t *home, int j, double v)
 {
     v = fabs(v);
-    if (J[j].vel_limit > 0 && v > J[j].vel_limit)
-        v = J[j].vel_limit;
+    if (home->J[j].vel_limit > 0 && v > home->J[j].vel_limit)
+        v = home->J[j].vel_limit;
     return v;
 }
 
-static void move(int j, double target, double vel)
+static void move(home_t *home, int j, double target, double vel)
 {
-    freeplan_t *fp = &J[j].free_tp;
+    freeplan_t *fp = &home->J[j].free_tp;
     fp->target = target;
-    fp->max_vel = speed(j, vel);
+    fp->max_vel = speed(home, j, vel);
     fp->enable = 1;
 }
 
-static void halt(int j)
+static void halt(home_t *home, int j)
 {
-    J[j].free_tp.enable = 0;
+    home->J[j].free_tp.enable = 0;
 }
 
-static int at_rest(int j)
+static int at_rest(const home_t *home, int j)
 {
-    return !J[j].free_tp.active;
+    return !home->J[j].free_tp.active;
 }
 
 /* the planner at rest at pos (the effect of fp_reset(), written here
@@ -221,36 +231,36 @@ static void plan_reset(freeplan_t *fp, double pos)
 
 /* make the latched point HOME_OFFSET: a new motor offset and every joint
    position shifted by the same amount, so motor_pos_cmd does not move */
-static void apply_offset(int j, double latched)
+static void apply_offset(home_t *home, int j, double latched)
 {
-    mot_joint_t *jt = &J[j];
-    double d = H[j].p.home_offset - latched;
+    mot_joint_t *jt = &home->J[j];
+    double d = home->H[j].p.home_offset - latched;
 
     jt->motor_offset -= d;
     jt->pos_cmd += d;
     jt->pos_fb += d;
     jt->coarse_pos += d;
     plan_reset(&jt->free_tp, jt->free_tp.pos + d);
-    H[j].prev_fb += d;
-    H[j].prev_cmd += d;
+    home->H[j].prev_fb += d;
+    home->H[j].prev_cmd += d;
 }
 
-static void set_flags(int j)
+static void set_flags(home_t *home, int j)
 {
-    unsigned f = J[j].flags & ~(MOT_JOINT_HOMING | MOT_JOINT_HOMED);
-    if (H[j].homing)
+    unsigned f = home->J[j].flags & ~(MOT_JOINT_HOMING | MOT_JOINT_HOMED);
+    if (home->H[j].homing)
         f |= MOT_JOINT_HOMING;
-    if (H[j].homed)
+    if (home->H[j].homed)
         f |= MOT_JOINT_HOMED;
-    J[j].flags = f;
+    home->J[j].flags = f;
 }
 
 /* end the homing of joint j without a home: stop its planner */
-static void drop(int j)
+static void drop(home_t *home, int j)
 {
-    home_joint_t *h = &H[j];
+    home_joint_t *h = &home->H[j];
     if (h->homing)
-        halt(j);
+        halt(home, j);
     if (h->ie_armed)
         h->ie_write = 0;
     h->ie_armed = 0;
@@ -259,13 +269,13 @@ static void drop(int j)
     h->homed = 0;
     h->latched = 0;
     h->state = HS_IDLE;
-    set_flags(j);
+    set_flags(home, j);
 }
 
 /* a failure of one joint ends all homing (a home all included) */
-static void fail(int j, const char *fmt, ...)
-    __attribute__((format(printf, 2, 3)));
-static void fail(int j, const char *fmt, ...)
+static void fail(home_t *home, int j, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+static void fail(home_t *home, int j, const char *fmt, ...)
 {
     char msg[200];
     va_list ap;
@@ -274,80 +284,82 @@ static void fail(int j, const char *fmt, ...)
     va_start(ap, fmt);
     vsnprintf(msg, sizeof(msg), fmt, ap);
     va_end(ap);
-    post("joint %d %s", j, msg);
-    for (k = 0; k < nj; k++)
-        if (H[k].homing)
-            drop(k);
-    all_seq = -1;
+    post(home, "joint %d %s", j, msg);
+    for (k = 0; k < home->nj; k++)
+        if (home->H[k].homing)
+            drop(home, k);
+    home->all_seq = -1;
 }
 
 /* ---- the per-joint state machine ---- */
 
-static void begin(int j)
+static void begin(home_t *home, int j)
 {
-    home_joint_t *h = &H[j];
+    home_joint_t *h = &home->H[j];
     h->homing = 1;
     h->homed = 0;
     h->latched = 0;
     h->ie_armed = 0;
     h->ie_found = 0;
     h->state = HS_START;
-    halt(j);
-    set_flags(j);
+    halt(home, j);
+    set_flags(home, j);
 }
 
-static void finish(int j)
+static void finish(home_t *home, int j)
 {
-    home_joint_t *h = &H[j];
+    home_joint_t *h = &home->H[j];
     h->homing = 0;
     h->homed = 1;
     h->state = HS_DONE;
-    set_flags(j);
+    set_flags(home, j);
 }
 
-static double final_speed(int j)
+static double final_speed(const home_t *home, int j)
 {
-    double v = H[j].p.home_final_vel;
+    double v = home->H[j].p.home_final_vel;
     if (!(v > 0))
-        v = J[j].vel_limit;
-    return speed(j, v);
+        v = home->J[j].vel_limit;
+    return speed(home, j, v);
 }
 
 /* after the offset is set: final move, or wait for the group, or done */
-static void after_latch(int j)
+static void after_latch(home_t *home, int j)
 {
-    home_joint_t *h = &H[j];
-    int g = seq_abs(j);
+    home_joint_t *h = &home->H[j];
+    int g = seq_abs(home, j);
 
-    if (abs_mode(j) == 2 || (h->p.flags & HOME_NO_FINAL_MOVE)) {
-        finish(j);
+    if (abs_mode(home, j) == 2 || (h->p.flags & HOME_NO_FINAL_MOVE)) {
+        finish(home, j);
         return;
     }
-    h->final_vel = final_speed(j);
-    if (seq_set(j) && group_sync(g)) {
+    h->final_vel = final_speed(home, j);
+    if (seq_set(home, j) && group_sync(home, g)) {
         h->state = HS_SYNC;
         return;
     }
-    move(j, h->p.home, h->final_vel);
+    move(home, j, h->p.home, h->final_vel);
     h->state = HS_FINAL;
 }
 
 /* start the latch phase from rest near the switch */
-static void start_latch(int j)
+static void start_latch(home_t *home, int j)
 {
-    home_joint_t *h = &H[j];
+    home_joint_t *h = &home->H[j];
     double ld = h->p.home_latch_vel > 0 ? 1.0 : -1.0;
-    move(j, J[j].free_tp.pos + ld * travel(j), h->p.home_latch_vel);
+    move(home, j, home->J[j].free_tp.pos + ld * travel(home, j),
+         h->p.home_latch_vel);
     h->sw_old = h->sw;
     h->state = HS_LATCH;
 }
 
 /* set index-enable and move (on) at latch speed in the latch direction */
-static void start_index(int j)
+static void start_index(home_t *home, int j)
 {
-    home_joint_t *h = &H[j];
+    home_joint_t *h = &home->H[j];
     double ld = h->p.home_latch_vel > 0 ? 1.0 : -1.0;
-    move(j, J[j].free_tp.pos + ld * travel(j), h->p.home_latch_vel);
+    move(home, j, home->J[j].free_tp.pos + ld * travel(home, j),
+         h->p.home_latch_vel);
     h->ie_armed = 1;
     h->ie_found = 0;
     h->ie_write = 1;
@@ -356,10 +368,10 @@ static void start_index(int j)
 
 /* the encoder cleared index-enable this cycle: find the index point in
    the joint coordinates in use before the home offset is applied */
-static void index_latch(int j)
+static void index_latch(home_t *home, int j)
 {
-    home_joint_t *h = &H[j];
-    mot_joint_t *jt = &J[j];
+    home_joint_t *h = &home->H[j];
+    mot_joint_t *jt = &home->J[j];
 
     if (h->p.flags & HOME_INDEX_NO_ENCODER_RESET) {
         h->latch = jt->pos_fb;
@@ -381,53 +393,53 @@ static void index_latch(int j)
     h->latched = 1;
 }
 
-static void step_joint(int j)
+static void step_joint(home_t *home, int j)
 {
-    home_joint_t *h = &H[j];
-    mot_joint_t *jt = &J[j];
+    home_joint_t *h = &home->H[j];
+    mot_joint_t *jt = &home->J[j];
     double sdir = h->p.home_search_vel > 0 ? 1.0 : -1.0;
     double pos = jt->free_tp.pos;
-    double t = travel(j);
+    double t = travel(home, j);
 
     switch (h->state) {
     case HS_START:
-        if (!at_rest(j))
+        if (!at_rest(home, j))
             break;
-        if (abs_mode(j)) {
-            apply_offset(j, jt->pos_fb);
-            after_latch(j);
+        if (abs_mode(home, j)) {
+            apply_offset(home, j, jt->pos_fb);
+            after_latch(home, j);
             break;
         }
         if (h->p.home_search_vel == 0) {
             if (h->p.flags & HOME_USE_INDEX) {
                 if (t <= 0) {
-                    fail(j, "homing: soft limits not set, no index search "
-                         "distance");
+                    fail(home, j, "homing: soft limits not set, no index "
+                         "search distance");
                     break;
                 }
-                start_index(j);
+                start_index(home, j);
             } else {
                 /* immediate: the commanded position is the home point */
-                apply_offset(j, jt->pos_cmd);
-                after_latch(j);
+                apply_offset(home, j, jt->pos_cmd);
+                after_latch(home, j);
             }
             break;
         }
         if (t <= 0) {
-            fail(j, "homing: soft limits not set, no search distance");
+            fail(home, j, "homing: soft limits not set, no search distance");
             break;
         }
         if (h->sw) {
             if (h->p.flags & HOME_IS_SHARED) {
-                fail(j, "home switch already closed at start of search "
+                fail(home, j, "home switch already closed at start of search "
                      "(HOME_IS_SHARED)");
                 break;
             }
-            move(j, pos - sdir * t, h->p.home_search_vel);
+            move(home, j, pos - sdir * t, h->p.home_search_vel);
             h->state = HS_BACKOFF;
             break;
         }
-        move(j, sdir > 0 ? fmax(pos, jt->max_pos_limit) + t
+        move(home, j, sdir > 0 ? fmax(pos, jt->max_pos_limit) + t
                          : fmin(pos, jt->min_pos_limit) - t,
              h->p.home_search_vel);
         h->state = HS_SEARCH;
@@ -435,17 +447,18 @@ static void step_joint(int j)
 
     case HS_BACKOFF:
         if (!h->sw) {
-            halt(j);
+            halt(home, j);
             h->state = HS_BACKOFF_STOP;
-        } else if (at_rest(j)) {
-            fail(j, "homing: home switch stayed closed while backing off");
+        } else if (at_rest(home, j)) {
+            fail(home, j, "homing: home switch stayed closed while "
+                 "backing off");
         }
         break;
 
     case HS_BACKOFF_STOP:
-        if (!at_rest(j))
+        if (!at_rest(home, j))
             break;
-        move(j, sdir > 0 ? fmax(pos, jt->max_pos_limit) + t
+        move(home, j, sdir > 0 ? fmax(pos, jt->max_pos_limit) + t
                          : fmin(pos, jt->min_pos_limit) - t,
              h->p.home_search_vel);
         h->state = HS_SEARCH;
@@ -453,37 +466,38 @@ static void step_joint(int j)
 
     case HS_SEARCH:
         if (h->sw) {
-            halt(j);
+            halt(home, j);
             h->state = HS_SEARCH_STOP;
-        } else if (at_rest(j)) {
-            fail(j, "homing: search ended without finding the switch");
+        } else if (at_rest(home, j)) {
+            fail(home, j, "homing: search ended without finding the switch");
         }
         break;
 
     case HS_SEARCH_STOP:
-        if (!at_rest(j))
+        if (!at_rest(home, j))
             break;
         if ((h->p.home_latch_vel > 0) == (sdir > 0)) {
             /* same direction: get off the switch first */
-            move(j, pos - sdir * t, h->p.home_search_vel);
+            move(home, j, pos - sdir * t, h->p.home_search_vel);
             h->state = HS_CLEAR;
         } else {
-            start_latch(j);
+            start_latch(home, j);
         }
         break;
 
     case HS_CLEAR:
         if (!h->sw) {
-            halt(j);
+            halt(home, j);
             h->state = HS_CLEAR_STOP;
-        } else if (at_rest(j)) {
-            fail(j, "homing: home switch stayed closed while backing off");
+        } else if (at_rest(home, j)) {
+            fail(home, j, "homing: home switch stayed closed while "
+                 "backing off");
         }
         break;
 
     case HS_CLEAR_STOP:
-        if (at_rest(j))
-            start_latch(j);
+        if (at_rest(home, j))
+            start_latch(home, j);
         break;
 
     case HS_LATCH: {
@@ -493,16 +507,16 @@ static void step_joint(int j)
         h->sw_old = h->sw;
         if (edge) {
             if (h->p.flags & HOME_USE_INDEX) {
-                start_index(j);
+                start_index(home, j);
             } else {
                 h->latch = jt->pos_fb;
                 h->latched = 1;
-                halt(j);
+                halt(home, j);
                 h->state = HS_SETTLE;
             }
-        } else if (at_rest(j)) {
-            fail(j, "homing: latch move ended without the home switch %s",
-                 rise ? "closing" : "opening");
+        } else if (at_rest(home, j)) {
+            fail(home, j, "homing: latch move ended without the home "
+                 "switch %s", rise ? "closing" : "opening");
         }
         break;
     }
@@ -511,28 +525,28 @@ static void step_joint(int j)
         if (h->ie_found) {
             h->ie_found = 0;
             h->ie_armed = 0;
-            index_latch(j);
-            halt(j);
+            index_latch(home, j);
+            halt(home, j);
             h->state = HS_SETTLE;
-        } else if (at_rest(j)) {
-            fail(j, "index pulse not found");
+        } else if (at_rest(home, j)) {
+            fail(home, j, "index pulse not found");
         }
         break;
 
     case HS_SETTLE:
-        if (!at_rest(j))
+        if (!at_rest(home, j))
             break;
-        apply_offset(j, h->latch);
-        after_latch(j);
+        apply_offset(home, j, h->latch);
+        after_latch(home, j);
         break;
 
     case HS_SYNC:
-        /* handled for the whole group by sync_step() */
+        /* handled for the whole group by sync_step(home) */
         break;
 
     case HS_FINAL:
-        if (at_rest(j))
-            finish(j);
+        if (at_rest(home, j))
+            finish(home, j);
         break;
 
     default:
@@ -542,41 +556,44 @@ static void step_joint(int j)
 
 /* start the final moves of a synchronized group when all its homing
    members wait; speeds are scaled so the moves take the same time */
-static void sync_step(void)
+static void sync_step(home_t *home)
 {
     int k, g;
-    for (g = 0; g <= nj; g++) {
+    for (g = 0; g <= home->nj; g++) {
         int n = 0, ready = 1;
         double tmax = 0;
-        for (k = 0; k < nj; k++) {
-            if (!H[k].homing || !seq_set(k) || seq_abs(k) != g)
+        for (k = 0; k < home->nj; k++) {
+            if (!home->H[k].homing || !seq_set(home, k) ||
+                seq_abs(home, k) != g)
                 continue;
             n++;
-            if (H[k].state != HS_SYNC) {
+            if (home->H[k].state != HS_SYNC) {
                 ready = 0;
                 break;
             }
-            if (H[k].final_vel > 0) {
-                double tk = fabs(H[k].p.home - J[k].free_tp.pos)
-                            / H[k].final_vel;
+            if (home->H[k].final_vel > 0) {
+                double tk = fabs(home->H[k].p.home - home->J[k].free_tp.pos)
+                            / home->H[k].final_vel;
                 if (tk > tmax)
                     tmax = tk;
             }
         }
         if (!n || !ready)
             continue;
-        for (k = 0; k < nj; k++) {
+        for (k = 0; k < home->nj; k++) {
             double v;
-            if (!H[k].homing || !seq_set(k) || seq_abs(k) != g)
+            if (!home->H[k].homing || !seq_set(home, k) ||
+                seq_abs(home, k) != g)
                 continue;
-            v = H[k].final_vel;
+            v = home->H[k].final_vel;
             if (tmax > 0) {
-                double vs = fabs(H[k].p.home - J[k].free_tp.pos) / tmax;
+                double vs = fabs(home->H[k].p.home -
+                                 home->J[k].free_tp.pos) / tmax;
                 if (vs > 0 && vs < v)
                     v = vs;
             }
-            move(k, H[k].p.home, v);
-            H[k].state = HS_FINAL;
+            move(home, k, home->H[k].p.home, v);
+            home->H[k].state = HS_FINAL;
         }
     }
 }
@@ -584,10 +601,10 @@ static void sync_step(void)
 /* ---- starting ---- */
 
 /* checks that do not depend on the other joints */
-static int can_start(int j, int quiet, char *why, int whylen)
+static int can_start(home_t *home, int j, int quiet, char *why, int whylen)
 {
-    home_joint_t *h = &H[j];
-    mot_joint_t *jt = &J[j];
+    home_joint_t *h = &home->H[j];
+    mot_joint_t *jt = &home->J[j];
 
     if (!(jt->flags & MOT_JOINT_ACTIVE)) {
         why_set(why, whylen, "joint %d is not active", j);
@@ -597,7 +614,7 @@ static int can_start(int j, int quiet, char *why, int whylen)
         why_set(why, whylen, "joint %d is homing already", j);
         return -EBUSY;
     }
-    if (h->homed && abs_mode(j)) {
+    if (h->homed && abs_mode(home, j)) {
         why_set(why, whylen, "joint %d has an absolute encoder and is "
                 "homed already (unhome it first)", j);
         return quiet ? 1 : -EINVAL;
@@ -609,13 +626,13 @@ static int can_start(int j, int quiet, char *why, int whylen)
     }
     if (jt->min_pos_limit < jt->max_pos_limit &&
         (h->p.home < jt->min_pos_limit || h->p.home > jt->max_pos_limit) &&
-        !(abs_mode(j) == 2 || (h->p.flags & HOME_NO_FINAL_MOVE))) {
+        !(abs_mode(home, j) == 2 || (h->p.flags & HOME_NO_FINAL_MOVE))) {
         why_set(why, whylen, "joint %d: HOME %g is outside the soft limits "
                 "[%g, %g]", j, h->p.home, jt->min_pos_limit,
                 jt->max_pos_limit);
         return -EINVAL;
     }
-    if (!abs_mode(j) && h->p.home_search_vel != 0 &&
+    if (!abs_mode(home, j) && h->p.home_search_vel != 0 &&
         (h->p.flags & HOME_IS_SHARED) && h->sw) {
         why_set(why, whylen, "joint %d home switch already closed at start "
                 "of search (HOME_IS_SHARED)", j);
@@ -624,46 +641,47 @@ static int can_start(int j, int quiet, char *why, int whylen)
     return 0;
 }
 
-static int any_homing(void)
+static int any_homing(const home_t *home)
 {
     int k;
-    for (k = 0; k < nj; k++)
-        if (H[k].homing)
+    for (k = 0; k < home->nj; k++)
+        if (home->H[k].homing)
             return 1;
     return 0;
 }
 
 /* the joints of group g (not skipped ones) start now; returns the number
    started or a negative errno */
-static int start_group(int g, int quiet, char *why, int whylen)
+static int start_group(home_t *home, int g, int quiet, char *why, int whylen)
 {
     int k, r, n = 0;
-    for (k = 0; k < nj; k++) {
-        if (!seq_set(k) || seq_abs(k) != g)
+    for (k = 0; k < home->nj; k++) {
+        if (!seq_set(home, k) || seq_abs(home, k) != g)
             continue;
-        r = can_start(k, quiet, why, whylen);
+        r = can_start(home, k, quiet, why, whylen);
         if (r < 0)
             return r;
     }
-    for (k = 0; k < nj; k++) {
-        if (!seq_set(k) || seq_abs(k) != g)
+    for (k = 0; k < home->nj; k++) {
+        if (!seq_set(home, k) || seq_abs(home, k) != g)
             continue;
-        if (can_start(k, 1, NULL, 0) == 1)
-            continue;           /* home all skips inactive joints, homed abs / no-rehome */
-        begin(k);
+        if (can_start(home, k, 1, NULL, 0) == 1)
+            continue;   /* home all skips inactive joints, homed abs /
+                           no-rehome */
+        begin(home, k);
         n++;
     }
     return n;
 }
 
-static int home_all(char *why, int whylen)
+static int home_all(home_t *home, char *why, int whylen)
 {
     int k, g, lo = -1, hi = -1, r;
 
-    for (k = 0; k < nj; k++) {
-        if (!seq_set(k))
+    for (k = 0; k < home->nj; k++) {
+        if (!seq_set(home, k))
             continue;
-        g = seq_abs(k);
+        g = seq_abs(home, k);
         if (lo < 0 || g < lo)
             lo = g;
         if (g > hi)
@@ -680,10 +698,10 @@ static int home_all(char *why, int whylen)
         return -EINVAL;
     }
     for (g = lo; g <= hi; g++) {
-        for (k = 0; k < nj; k++)
-            if (seq_set(k) && seq_abs(k) == g)
+        for (k = 0; k < home->nj; k++)
+            if (seq_set(home, k) && seq_abs(home, k) == g)
                 break;
-        if (k == nj) {
+        if (k == home->nj) {
             why_set(why, whylen, "HOME_SEQUENCE has a gap: no joint has "
                     "sequence %d but some have %d", g, hi);
             return -EINVAL;
@@ -691,51 +709,52 @@ static int home_all(char *why, int whylen)
     }
     /* check every group now, so home all does not stop half-way on a
        configuration error */
-    for (k = 0; k < nj; k++) {
-        if (!seq_set(k))
+    for (k = 0; k < home->nj; k++) {
+        if (!seq_set(home, k))
             continue;
-        r = can_start(k, 1, why, whylen);
+        r = can_start(home, k, 1, why, whylen);
         if (r < 0)
             return r;
     }
     for (g = lo; g <= hi; g++) {
-        r = start_group(g, 1, why, whylen);
+        r = start_group(home, g, 1, why, whylen);
         if (r < 0)
             return r;
         if (r > 0)
             break;
     }
-    all_seq = g <= hi ? g : -1;
+    home->all_seq = g <= hi ? g : -1;
     return 0;
 }
 
 /* home all: when the running group has finished, start the next one */
-static void home_all_step(void)
+static void home_all_step(home_t *home)
 {
     int k, g, hi = -1;
     char why[160];
 
-    if (all_seq < 0)
+    if (home->all_seq < 0)
         return;
-    for (k = 0; k < nj; k++) {
-        if (seq_set(k) && seq_abs(k) == all_seq && H[k].homing)
+    for (k = 0; k < home->nj; k++) {
+        if (seq_set(home, k) && seq_abs(home, k) == home->all_seq &&
+            home->H[k].homing)
             return;
-        if (seq_set(k) && seq_abs(k) > hi)
-            hi = seq_abs(k);
+        if (seq_set(home, k) && seq_abs(home, k) > hi)
+            hi = seq_abs(home, k);
     }
-    for (g = all_seq + 1; g <= hi; g++) {
-        int r = start_group(g, 1, why, sizeof(why));
+    for (g = home->all_seq + 1; g <= hi; g++) {
+        int r = start_group(home, g, 1, why, sizeof(why));
         if (r < 0) {
-            post("home all stopped at sequence %d: %s", g, why);
-            all_seq = -1;
+            post(home, "home all stopped at sequence %d: %s", g, why);
+            home->all_seq = -1;
             return;
         }
         if (r > 0) {
-            all_seq = g;
+            home->all_seq = g;
             return;
         }
     }
-    all_seq = -1;
+    home->all_seq = -1;
 }
 
 /* ---- the API ---- */
@@ -743,6 +762,7 @@ static void home_all_step(void)
 static int hm_init(int mot_comp, double servo_period, int njoints,
                    int nextra, mot_joint_t *joints)
 {
+    home_t *home = &homing;
     int j, r;
 
     (void)nextra;
@@ -750,15 +770,15 @@ static int hm_init(int mot_comp, double servo_period, int njoints,
         rtapi_print_msg(RTAPI_MSG_ERR, "homemod: bad init arguments\n");
         return -EINVAL;
     }
-    H = hal_malloc(njoints * sizeof(*H));
-    P = hal_malloc(njoints * sizeof(*P));
-    if (!H || !P) {
+    home->H = hal_malloc(njoints * sizeof(*home->H));
+    home->P = hal_malloc(njoints * sizeof(*home->P));
+    if (!home->H || !home->P) {
         rtapi_print_msg(RTAPI_MSG_ERR, "homemod: out of HAL memory\n");
         return -ENOMEM;
     }
-    memset(H, 0, njoints * sizeof(*H));
+    memset(home->H, 0, njoints * sizeof(*home->H));
     for (j = 0; j < njoints; j++) {
-        home_pins_t *p = &P[j];
+        home_pins_t *p = &home->P[j];
         if ((r = hal_pin_bit_newf(HAL_IN, &p->sw_in, mot_comp,
                                   "joint.%d.home-sw-in", j)) < 0 ||
             (r = hal_pin_bit_newf(HAL_OUT, &p->homing, mot_comp,
@@ -778,38 +798,40 @@ static int hm_init(int mot_comp, double servo_period, int njoints,
         *p->homed = 0;
         *p->state = 0;
         *p->index_enable = 0;
-        H[j].p.home_sequence = SEQ_NONE;
-        H[j].ie_write = -1;
+        home->H[j].p.home_sequence = SEQ_NONE;
+        home->H[j].ie_write = -1;
     }
-    nj = njoints;
-    dt = servo_period;
-    J = joints;
-    all_seq = -1;
-    errbuf[0] = 0;
+    home->nj = njoints;
+    home->dt = servo_period;
+    home->J = joints;
+    home->all_seq = -1;
+    home->errbuf[0] = 0;
     return 0;
 }
 
 static void hm_read_inputs(void)
 {
+    home_t *home = &homing;
     int j;
-    if (!J)
+    if (!home->J)
         return;
-    for (j = 0; j < nj; j++) {
-        home_joint_t *h = &H[j];
-        h->sw = *P[j].sw_in ? 1 : 0;
-        if (h->ie_armed && h->ie_write < 0 && !*P[j].index_enable)
+    for (j = 0; j < home->nj; j++) {
+        home_joint_t *h = &home->H[j];
+        h->sw = *home->P[j].sw_in ? 1 : 0;
+        if (h->ie_armed && h->ie_write < 0 && !*home->P[j].index_enable)
             h->ie_found = 1;
     }
 }
 
 static void hm_write_outputs(void)
 {
+    home_t *home = &homing;
     int j;
-    if (!J)
+    if (!home->J)
         return;
-    for (j = 0; j < nj; j++) {
-        home_joint_t *h = &H[j];
-        home_pins_t *p = &P[j];
+    for (j = 0; j < home->nj; j++) {
+        home_joint_t *h = &home->H[j];
+        home_pins_t *p = &home->P[j];
         if (h->ie_write >= 0) {
             *p->index_enable = h->ie_write;
             h->ie_write = -1;
@@ -823,18 +845,19 @@ static void hm_write_outputs(void)
 static int hm_set_params(int j, const mot_home_params_t *in, char *why,
                          int whylen)
 {
+    home_t *home = &homing;
     mot_home_params_t p;
     mot_joint_t *jt;
 
-    if (bad_joint(j, why, whylen))
+    if (bad_joint(home, j, why, whylen))
         return -EINVAL;
     if (!in) {
         why_set(why, whylen, "joint %d: no homing parameters", j);
         return -EINVAL;
     }
     p = *in;
-    jt = &J[j];
-    if (H[j].homing) {
+    jt = &home->J[j];
+    if (home->H[j].homing) {
         why_set(why, whylen, "joint %d is homing: parameters cannot change "
                 "now", j);
         return -EBUSY;
@@ -868,9 +891,10 @@ static int hm_set_params(int j, const mot_home_params_t *in, char *why,
         }
     }
     if (p.home_sequence != SEQ_NONE &&
-        (p.home_sequence > nj || p.home_sequence < -nj)) {
+        (p.home_sequence > home->nj || p.home_sequence < -home->nj)) {
         why_set(why, whylen, "joint %d: HOME_SEQUENCE %d is out of range "
-                "(sequences run 0..%d without gaps)", j, p.home_sequence, nj);
+                "(sequences run 0..%d without gaps)", j, p.home_sequence,
+                home->nj);
         return -EINVAL;
     }
     if (jt->min_pos_limit < jt->max_pos_limit &&
@@ -881,174 +905,182 @@ static int hm_set_params(int j, const mot_home_params_t *in, char *why,
         return -EINVAL;
     }
     p.volatile_home = p.volatile_home ? 1 : 0;
-    H[j].p = p;
+    home->H[j].p = p;
     return 0;
 }
 
 static int hm_start(int j, char *why, int whylen)
 {
+    home_t *home = &homing;
     int r, g, k;
 
-    if (!J) {
+    if (!home->J) {
         why_set(why, whylen, "homing is not initialized (motmod not loaded)");
         return -EINVAL;
     }
-    if (any_homing() || all_seq >= 0) {
+    if (any_homing(home) || home->all_seq >= 0) {
         why_set(why, whylen, "homing is in progress already");
         return -EBUSY;
     }
     if (j == -1)
-        return home_all(why, whylen);
-    if (bad_joint(j, why, whylen))
+        return home_all(home, why, whylen);
+    if (bad_joint(home, j, why, whylen))
         return -EINVAL;
-    r = can_start(j, 0, why, whylen);
+    r = can_start(home, j, 0, why, whylen);
     if (r < 0)
         return r;
-    if (seq_set(j)) {
-        g = seq_abs(j);
+    if (seq_set(home, j)) {
+        g = seq_abs(home, j);
         /* the order of the sequences holds for single joints too */
-        for (k = 0; k < nj; k++) {
-            if (seq_set(k) && seq_abs(k) < g && !H[k].homed
-                && (J[k].flags & MOT_JOINT_ACTIVE)) {
+        for (k = 0; k < home->nj; k++) {
+            if (seq_set(home, k) && seq_abs(home, k) < g && !home->H[k].homed
+                && (home->J[k].flags & MOT_JOINT_ACTIVE)) {
                 why_set(why, whylen, "joint %d (HOME_SEQUENCE %d) cannot "
                         "home before joint %d (HOME_SEQUENCE %d) is homed",
-                        j, H[j].p.home_sequence, k, H[k].p.home_sequence);
+                        j, home->H[j].p.home_sequence, k,
+                        home->H[k].p.home_sequence);
                 return -EINVAL;
             }
         }
-        if (group_sync(g)) {
+        if (group_sync(home, g)) {
             /* a synchronized group homes together */
-            for (k = 0; k < nj; k++) {
-                if (k == j || !seq_set(k) || seq_abs(k) != g)
+            for (k = 0; k < home->nj; k++) {
+                if (k == j || !seq_set(home, k) || seq_abs(home, k) != g)
                     continue;
-                r = can_start(k, 0, why, whylen);
+                r = can_start(home, k, 0, why, whylen);
                 if (r < 0)
                     return r;
             }
-            start_group(g, 0, why, whylen);
+            start_group(home, g, 0, why, whylen);
             return 0;
         }
     }
-    begin(j);
+    begin(home, j);
     return 0;
 }
 
 static int hm_unhome(int j, char *why, int whylen)
 {
+    home_t *home = &homing;
     int k;
 
-    if (!J) {
+    if (!home->J) {
         why_set(why, whylen, "homing is not initialized (motmod not loaded)");
         return -EINVAL;
     }
     if (j == -1 || j == -2) {
-        for (k = 0; k < nj; k++) {
-            if (j == -2 && !H[k].p.volatile_home)
+        for (k = 0; k < home->nj; k++) {
+            if (j == -2 && !home->H[k].p.volatile_home)
                 continue;
-            if (H[k].homing) {
+            if (home->H[k].homing) {
                 why_set(why, whylen, "joint %d is homing: abort it before "
                         "unhoming", k);
                 return -EBUSY;
             }
         }
-        for (k = 0; k < nj; k++) {
-            if (j == -2 && !H[k].p.volatile_home)
+        for (k = 0; k < home->nj; k++) {
+            if (j == -2 && !home->H[k].p.volatile_home)
                 continue;
-            H[k].homed = 0;
-            if (H[k].state == HS_DONE)
-                H[k].state = HS_IDLE;
-            set_flags(k);
+            home->H[k].homed = 0;
+            if (home->H[k].state == HS_DONE)
+                home->H[k].state = HS_IDLE;
+            set_flags(home, k);
         }
         return 0;
     }
-    if (bad_joint(j, why, whylen))
+    if (bad_joint(home, j, why, whylen))
         return -EINVAL;
-    if (H[j].homing) {
+    if (home->H[j].homing) {
         why_set(why, whylen, "joint %d is homing: abort it before unhoming",
                 j);
         return -EBUSY;
     }
-    H[j].homed = 0;
-    if (H[j].state == HS_DONE)
-        H[j].state = HS_IDLE;
-    set_flags(j);
+    home->H[j].homed = 0;
+    if (home->H[j].state == HS_DONE)
+        home->H[j].state = HS_IDLE;
+    set_flags(home, j);
     return 0;
 }
 
 static void hm_abort(void)
 {
+    home_t *home = &homing;
     int k, n = 0;
     char list[96];
     size_t len = 0;
 
-    if (!J)
+    if (!home->J)
         return;
     list[0] = 0;
-    for (k = 0; k < nj; k++) {
-        if (!H[k].homing)
+    for (k = 0; k < home->nj; k++) {
+        if (!home->H[k].homing)
             continue;
         if (len + 8 < sizeof(list))
             len += snprintf(list + len, sizeof(list) - len, "%s%d",
                             n ? ", " : "", k);
         n++;
-        drop(k);
+        drop(home, k);
     }
-    all_seq = -1;
+    home->all_seq = -1;
     if (n)
-        post("homing aborted (joint%s %s)", n > 1 ? "s" : "", list);
+        post(home, "homing aborted (joint%s %s)", n > 1 ? "s" : "", list);
 }
 
 static int hm_run(void)
 {
+    home_t *home = &homing;
     int j, busy = 0;
 
-    if (!J)
+    if (!home->J)
         return 0;
-    for (j = 0; j < nj; j++) {
-        home_joint_t *h = &H[j];
+    for (j = 0; j < home->nj; j++) {
+        home_joint_t *h = &home->H[j];
         if (h->state == HS_DONE && !h->homing)
             h->state = HS_IDLE;
         if (h->homing) {
-            step_joint(j);
+            step_joint(home, j);
             busy = 1;
         }
     }
-    if (!busy && all_seq < 0)
+    if (!busy && home->all_seq < 0)
         return 0;
-    sync_step();
-    home_all_step();
+    sync_step(home);
+    home_all_step(home);
     busy = 0;
-    for (j = 0; j < nj; j++) {
-        if (!H[j].homing)
+    for (j = 0; j < home->nj; j++) {
+        if (!home->H[j].homing)
             continue;
         /* for the estimate of an encoder reset (index_latch) */
-        H[j].prev_fb = J[j].pos_fb;
-        H[j].prev_cmd = J[j].pos_cmd;
+        home->H[j].prev_fb = home->J[j].pos_fb;
+        home->H[j].prev_cmd = home->J[j].pos_cmd;
         busy = 1;
     }
-    return busy || all_seq >= 0;
+    return busy || home->all_seq >= 0;
 }
 
 static int hm_is_homed(int j)
 {
-    return J && j >= 0 && j < nj && H[j].homed;
+    home_t *home = &homing;
+    return home->J && j >= 0 && j < home->nj && home->H[j].homed;
 }
 
 static int hm_is_homing(int j)
 {
-    return J && j >= 0 && j < nj && H[j].homing;
+    home_t *home = &homing;
+    return home->J && j >= 0 && j < home->nj && home->H[j].homing;
 }
 
 /* all active joints homed (and at least one active) */
 static int hm_all_homed(void)
 {
+    home_t *home = &homing;
     int j, n = 0;
-    if (!J)
+    if (!home->J)
         return 0;
-    for (j = 0; j < nj; j++) {
-        if (!(J[j].flags & MOT_JOINT_ACTIVE))
+    for (j = 0; j < home->nj; j++) {
+        if (!(home->J[j].flags & MOT_JOINT_ACTIVE))
             continue;
-        if (!H[j].homed)
+        if (!home->H[j].homed)
             return 0;
         n++;
     }
@@ -1057,23 +1089,26 @@ static int hm_all_homed(void)
 
 static int hm_state(int j)
 {
-    return (J && j >= 0 && j < nj) ? H[j].state : 0;
+    home_t *home = &homing;
+    return (home->J && j >= 0 && j < home->nj) ? home->H[j].state : 0;
 }
 
 static int hm_ignores_limits(int j)
 {
-    return J && j >= 0 && j < nj && H[j].homing &&
-           (H[j].p.flags & HOME_IGNORE_LIMITS);
+    home_t *home = &homing;
+    return home->J && j >= 0 && j < home->nj && home->H[j].homing &&
+           (home->H[j].p.flags & HOME_IGNORE_LIMITS);
 }
 
 static const char *hm_take_error(void)
 {
-    if (!errbuf[0])
+    home_t *home = &homing;
+    if (!home->errbuf[0])
         return "";
-    strncpy(errout, errbuf, sizeof(errout) - 1);
-    errout[sizeof(errout) - 1] = 0;
-    errbuf[0] = 0;
-    return errout;
+    strncpy(home->errout, home->errbuf, sizeof(home->errout) - 1);
+    home->errout[sizeof(home->errout) - 1] = 0;
+    home->errbuf[0] = 0;
+    return home->errout;
 }
 
 const mot_homing_api_t halsdk_homing_api = {
@@ -1106,7 +1141,7 @@ int rtapi_app_main(void)
 
 void rtapi_app_exit(void)
 {
-    J = NULL;
+    homing.J = NULL;
     if (comp_id >= 0)
         hal_exit(comp_id);
 }

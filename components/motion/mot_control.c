@@ -55,7 +55,7 @@
 /* backlash and screw compensation (mot_comp.h): the correction follows
    the direction of the commanded motion, limited to a share of the
    joint's velocity and acceleration limits */
-static inline void mot_comp_joint(int n, double dt)
+static inline void mot_comp_joint(mot_t *mot, int n, double dt)
 {
     mot_joint_t *j = &mot->joints[n];
     mot_comp_t *c = &mot->comp[n];
@@ -78,13 +78,13 @@ static inline void mot_comp_joint(int n, double dt)
 
 /* ------------------------------------------------------------------ */
 
-static int posthome_joint(int n);
+static int posthome_joint(mot_t *mot, int n);
 
 #define HOMED(n) (mot->homed_c[(n)])
 #define HOMING(n) (mot->homing_c[(n)])
 
 /* read the homing state once per cycle */
-static void refresh_home_cache(void)
+static void refresh_home_cache(mot_t *mot)
 {
     int i, all = 1, any = 0;
     for (i = 0; i < mot->num_joints; i++) {
@@ -102,7 +102,7 @@ static void refresh_home_cache(void)
 static KINEMATICS_FORWARD_FLAGS fflags;
 static KINEMATICS_INVERSE_FLAGS iflags;
 
-int mot_forward(const double *joints, EmcPose *pos)
+int mot_forward(mot_t *mot, const double *joints, EmcPose *pos)
 {
     double jt[KINS_MAX_JOINTS];
     int i;
@@ -111,12 +111,12 @@ int mot_forward(const double *joints, EmcPose *pos)
     return mot->kins_fwd(jt, pos, &fflags, &iflags);
 }
 
-int mot_inverse(const EmcPose *pos, double *joints)
+int mot_inverse(mot_t *mot, const EmcPose *pos, double *joints)
 {
     return mot->kins_inv(pos, joints, &iflags, &fflags);
 }
 
-void mot_post(const char *fmt, ...)
+void mot_post(mot_t *mot, const char *fmt, ...)
 {
     mot_channel_t *ch = mot->chan;
     va_list ap;
@@ -135,18 +135,18 @@ void mot_post(const char *fmt, ...)
     rtapi_print_msg(RTAPI_MSG_ERR, "motion: %s\n", m->text);
 }
 
-static int used_kins_joints(void)
+static int used_kins_joints(mot_t *mot)
 {
     return mot->num_joints_used - mot->num_extra > 0
            ? mot->num_joints_used - mot->num_extra : 0;
 }
 
-static int is_extra(int j)
+static int is_extra(mot_t *mot, int j)
 {
     return j >= mot->num_joints - mot->num_extra;
 }
 
-int mot_all_homed(void)
+int mot_all_homed(mot_t *mot)
 {
     int i;
     for (i = 0; i < mot->num_joints_used; i++)
@@ -156,12 +156,12 @@ int mot_all_homed(void)
 }
 
 /* the carte <-> joint transforms mean something */
-static int kins_valid(void)
+static int kins_valid(mot_t *mot)
 {
     return mot->kins_type == KINEMATICS_IDENTITY || mot->all_homed_c;
 }
 
-int mot_moving(void)
+int mot_moving(mot_t *mot)
 {
     int i;
     for (i = 0; i < mot->num_joints_used; i++) {
@@ -176,27 +176,27 @@ int mot_moving(void)
     return 0;
 }
 
-static int profile_for(double jerk)
+static int profile_for(mot_t *mot, double jerk)
 {
     return (mot->profile == FP_JERK && jerk > 0) ? FP_JERK : FP_TRAPEZOID;
 }
 
-void mot_joint_limits_to_planner(int n)
+void mot_joint_limits_to_planner(mot_t *mot, int n)
 {
     mot_joint_t *j = &mot->joints[n];
     j->free_tp.max_acc = j->acc_limit;
     j->free_tp.max_jerk = j->jerk_limit;
-    j->free_tp.profile = profile_for(j->jerk_limit);
+    j->free_tp.profile = profile_for(mot, j->jerk_limit);
     if (j->free_tp.max_vel <= 0 || j->free_tp.max_vel > j->vel_limit)
         j->free_tp.max_vel = j->vel_limit;
 }
 
-void mot_axis_limits_to_planner(int n)
+void mot_axis_limits_to_planner(mot_t *mot, int n)
 {
     mot_axis_t *a = &mot->axis[n];
     a->tp.max_acc = a->acc_limit;
     a->tp.max_jerk = a->jerk_limit;
-    a->tp.profile = profile_for(a->jerk_limit);
+    a->tp.profile = profile_for(mot, a->jerk_limit);
     if (a->tp.max_vel <= 0 || a->tp.max_vel > a->vel_limit)
         a->tp.max_vel = a->vel_limit;
 }
@@ -204,36 +204,36 @@ void mot_axis_limits_to_planner(int n)
 /* every planner at rest where the machine is now */
 /* carte_pos_cmd from the joints' pos_cmd, when the forward kinematics
    can be trusted (otherwise it keeps its value) */
-static void carte_cmd_from_joints(void)
+static void carte_cmd_from_joints(mot_t *mot)
 {
     double jt[MOT_MAX_JOINTS];
     EmcPose p;
     int i;
 
-    if (!kins_valid())
+    if (!kins_valid(mot))
         return;
     for (i = 0; i < mot->num_joints; i++)
         jt[i] = mot->joints[i].pos_cmd;
-    if (mot_forward(jt, &p) == 0)
+    if (mot_forward(mot, jt, &p) == 0)
         mot->carte_pos_cmd = p;
 }
 
-void mot_sync_planners(void)
+void mot_sync_planners(mot_t *mot)
 {
     int i;
 
     for (i = 0; i < mot->num_joints; i++) {
         mot_joint_t *j = &mot->joints[i];
         fp_reset(&j->free_tp, j->pos_cmd);
-        mot_joint_limits_to_planner(i);
+        mot_joint_limits_to_planner(mot, i);
         j->coarse_pos = j->pos_cmd;
         j->vel_cmd = j->acc_cmd = 0.0;
         mot->jog_kind[i] = MOT_JOG_NONE;
     }
-    carte_cmd_from_joints();
+    carte_cmd_from_joints(mot);
     for (i = 0; i < MOT_MAX_AXES; i++) {
         fp_reset(&mot->axis[i].tp, *emcpose_axis(&mot->carte_pos_cmd, i));
-        mot_axis_limits_to_planner(i);
+        mot_axis_limits_to_planner(mot, i);
         mot->axis[i].jog = MOT_JOG_NONE;
         mot->axis[i].vel_cmd = 0.0;
     }
@@ -241,7 +241,7 @@ void mot_sync_planners(void)
     mot->traj_count = 0;
 }
 
-static void end_override_if(int who)
+static void end_override_if(mot_t *mot, int who)
 {
     if (mot->override_limits && mot->override_jog == who) {
         mot->override_limits = 0;
@@ -249,7 +249,7 @@ static void end_override_if(int who)
     }
 }
 
-void mot_disable(void)
+void mot_disable(mot_t *mot)
 {
     int i;
 
@@ -264,13 +264,13 @@ void mot_disable(void)
         else
             mot->tp->abort();
     }
-    mot_line_clear();
-    mot_queue_drop();
-    mot_spindles_stop();
+    mot_line_clear(mot);
+    mot_queue_drop(mot);
+    mot_spindles_stop(mot);
     mot->enabled = 0;
     for (i = 0; i < mot->num_joints; i++)
         mot->amp_on[i] = 0;
-    mot_sync_planners();
+    mot_sync_planners(mot);
     /* the jog that ends an override ended now */
     if (mot->override_jog >= 0) {
         mot->override_limits = 0;
@@ -278,15 +278,15 @@ void mot_disable(void)
     }
 }
 
-static void fault(void)
+static void fault(mot_t *mot)
 {
     mot->error = 1;
-    mot_disable();
+    mot_disable(mot);
 }
 
 /* ------------------------------------------------------------------ */
 
-static void read_inputs(void)
+static void read_inputs(mot_t *mot)
 {
     int i;
     for (i = 0; i < mot->num_joints; i++) {
@@ -322,7 +322,7 @@ static double ferror_limit(const mot_joint_t *j)
 }
 
 /* returns 1 when a fault disabled motion */
-static int check_faults(void)
+static int check_faults(mot_t *mot)
 {
     int i;
     mot_motion_pins_t *mp = mot->mp;
@@ -330,14 +330,15 @@ static int check_faults(void)
     if (!mot->enabled)
         return 0;
     if (!*mp->enable) {
-        mot_post("motion.enable went false: motion disabled");
-        fault();
+        mot_post(mot, "motion.enable went false: motion disabled");
+        fault(mot);
         return 1;
     }
     for (i = 0; i < mot->num_misc; i++) {
         if (*mp->misc_error[i]) {
-            mot_post("motion.misc-error-%02d is true: motion disabled", i);
-            fault();
+            mot_post(mot, "motion.misc-error-%02d is true: motion disabled",
+                     i);
+            fault(mot);
             return 1;
         }
     }
@@ -347,25 +348,25 @@ static int check_faults(void)
             continue;
         if (j->flags & MOT_JOINT_FAULT) {
             j->flags |= MOT_JOINT_ERROR;
-            mot_post("amplifier fault on joint %d: motion disabled", i);
-            fault();
+            mot_post(mot, "amplifier fault on joint %d: motion disabled", i);
+            fault(mot);
             return 1;
         }
         if ((j->pos_limit_sw || j->neg_limit_sw) && !mot->override_limits
             && !mot->home->ignores_limits(i)) {
             j->flags |= MOT_JOINT_ERROR;
-            mot_post("joint %d on %s hard limit: motion disabled", i,
+            mot_post(mot, "joint %d on %s hard limit: motion disabled", i,
                      j->pos_limit_sw ? "positive" : "negative");
-            fault();
+            fault(mot);
             return 1;
         }
         j->ferror_limit = ferror_limit(j);
-        if (fabs(j->ferror) > j->ferror_limit && !posthome_joint(i)) {
+        if (fabs(j->ferror) > j->ferror_limit && !posthome_joint(mot, i)) {
             j->flags |= MOT_JOINT_ERROR | MOT_JOINT_FERROR;
-            mot_post("joint %d following error: %.6g exceeds the limit "
+            mot_post(mot, "joint %d following error: %.6g exceeds the limit "
                      "%.6g: motion disabled", i, fabs(j->ferror),
                      j->ferror_limit);
-            fault();
+            fault(mot);
             return 1;
         }
     }
@@ -373,7 +374,7 @@ static int check_faults(void)
 }
 
 /* soft limits apply to a homed joint */
-static double clamp_joint(int n, double t)
+static double clamp_joint(mot_t *mot, int n, double t)
 {
     mot_joint_t *j = &mot->joints[n];
     if (!HOMED(n))
@@ -385,10 +386,10 @@ static double clamp_joint(int n, double t)
     return t;
 }
 
-static double clamp_axis(int n, double t)
+static double clamp_axis(mot_t *mot, int n, double t)
 {
     mot_axis_t *a = &mot->axis[n];
-    if (!kins_valid() || mot->kins_type == KINEMATICS_IDENTITY) {
+    if (!kins_valid(mot) || mot->kins_type == KINEMATICS_IDENTITY) {
         /* identity kins: the joints' soft limits guard the axes too */
         if (!mot->all_homed_c)
             return t;
@@ -401,7 +402,7 @@ static double clamp_axis(int n, double t)
 }
 
 /* jog wheel of joint n (free mode) */
-static void wheel_joint(int n)
+static void wheel_joint(mot_t *mot, int n)
 {
     mot_joint_t *j = &mot->joints[n];
     mot_joint_pins_t *p = &mot->jp[n];
@@ -425,7 +426,7 @@ static void wheel_joint(int n)
     }
     t = (mot->jog_kind[n] == MOT_JOG_WHEEL && j->free_tp.enable)
         ? j->free_tp.target : j->pos_cmd;
-    t = clamp_joint(n, t + delta * *p->jog_scale);
+    t = clamp_joint(mot, n, t + delta * *p->jog_scale);
     frac = *p->jog_accel_fraction;
     if (!(frac > 0) || frac > 1)
         frac = 1;
@@ -436,7 +437,7 @@ static void wheel_joint(int n)
     mot->jog_kind[n] = MOT_JOG_WHEEL;
 }
 
-static void wheel_axis(int n)
+static void wheel_axis(mot_t *mot, int n)
 {
     mot_axis_t *a = &mot->axis[n];
     mot_axis_pins_t *p = &mot->ap[n];
@@ -459,7 +460,7 @@ static void wheel_axis(int n)
     }
     t = (a->jog == MOT_JOG_WHEEL && a->tp.enable) ? a->tp.target
         : a->tp.pos;
-    t = clamp_axis(n, t + delta * *p->jog_scale);
+    t = clamp_axis(mot, n, t + delta * *p->jog_scale);
     frac = *p->jog_accel_fraction;
     if (!(frac > 0) || frac > 1)
         frac = 1;
@@ -473,18 +474,18 @@ static void wheel_axis(int n)
 /* run joint n's free planner one cycle; pos/vel/acc commands follow */
 /* a homed extra joint: its command comes from joint.N.posthome-cmd
    (motion(9)); its feedback is not used */
-static int posthome_joint(int n)
+static int posthome_joint(mot_t *mot, int n)
 {
     return mot->jp[n].posthome_cmd && HOMED(n)
            && !HOMING(n);
 }
 
-static void run_free_joint(int n, double dt)
+static void run_free_joint(mot_t *mot, int n, double dt)
 {
     mot_joint_t *j = &mot->joints[n];
     double old = j->pos_cmd, oldv = j->vel_cmd;
 
-    if (posthome_joint(n)) {
+    if (posthome_joint(mot, n)) {
         double p = *mot->jp[n].posthome_cmd;
         if (!isfinite(p))
             p = old;
@@ -496,7 +497,7 @@ static void run_free_joint(int n, double dt)
         return;
     }
 
-    wheel_joint(n);
+    wheel_joint(mot, n);
     if (*mot->mp->jog_stop_immediate && mot->jog_kind[n] != MOT_JOG_NONE) {
         fp_reset(&j->free_tp, j->free_tp.pos);
     } else if ((*mot->mp->jog_stop || *mot->mp->jog_inhibit)
@@ -532,13 +533,13 @@ static void run_free_joint(int n, double dt)
     j->acc_cmd = (j->vel_cmd - oldv) / dt;
     if (mot->jog_kind[n] != MOT_JOG_NONE && !j->free_tp.active) {
         mot->jog_kind[n] = MOT_JOG_NONE;
-        end_override_if(n);
+        end_override_if(mot, n);
     }
 }
 
-static void set_joint_cmds(const double *pos, double dt)
+static void set_joint_cmds(mot_t *mot, const double *pos, double dt)
 {
-    int i, nk = used_kins_joints();
+    int i, nk = used_kins_joints(mot);
     for (i = 0; i < nk; i++) {
         mot_joint_t *j = &mot->joints[i];
         double v = (pos[i] - j->pos_cmd) / dt;
@@ -550,16 +551,16 @@ static void set_joint_cmds(const double *pos, double dt)
     }
 }
 
-static void run_teleop(double dt)
+static void run_teleop(mot_t *mot, double dt)
 {
-    int i, nk = used_kins_joints();
+    int i, nk = used_kins_joints(mot);
     EmcPose p;
     double jt[KINS_MAX_JOINTS];
 
     for (i = 0; i < MOT_MAX_AXES; i++) {
         mot_axis_t *a = &mot->axis[i];
         double old = a->tp.pos;
-        wheel_axis(i);
+        wheel_axis(mot, i);
         if (*mot->mp->jog_stop_immediate && a->jog != MOT_JOG_NONE)
             fp_reset(&a->tp, a->tp.pos);
         else if ((*mot->mp->jog_stop || *mot->mp->jog_inhibit)
@@ -569,24 +570,24 @@ static void run_teleop(double dt)
         a->vel_cmd = (a->tp.pos - old) / dt;
         if (a->jog != MOT_JOG_NONE && !a->tp.active) {
             a->jog = MOT_JOG_NONE;
-            end_override_if(100 + i);
+            end_override_if(mot, 100 + i);
         }
         *emcpose_axis(&p, i) = a->tp.pos;
     }
     for (i = 0; i < KINS_MAX_JOINTS; i++)
         jt[i] = i < mot->num_joints ? mot->joints[i].pos_cmd : 0.0;
-    if (mot_inverse(&p, jt) != 0) {
-        mot_post("teleop: inverse kinematics failed at the commanded "
+    if (mot_inverse(mot, &p, jt) != 0) {
+        mot_post(mot, "teleop: inverse kinematics failed at the commanded "
                  "position: motion disabled");
-        fault();
+        fault(mot);
         return;
     }
     for (i = 0; i < nk; i++) {
         mot_joint_t *j = &mot->joints[i];
         if (!isfinite(jt[i])) {
-            mot_post("teleop: inverse kinematics gave joint %d no valid "
+            mot_post(mot, "teleop: inverse kinematics gave joint %d no valid "
                      "position: motion disabled", i);
-            fault();
+            fault(mot);
             return;
         }
         if (HOMED(i)
@@ -594,7 +595,7 @@ static void run_teleop(double dt)
                 || (jt[i] < j->min_pos_limit && jt[i] < j->pos_cmd))) {
             /* stop where we are: a joint would leave its range */
             int k;
-            mot_post("teleop move stopped: joint %d would pass its %s "
+            mot_post(mot, "teleop move stopped: joint %d would pass its %s "
                      "soft limit", i,
                      jt[i] > j->max_pos_limit ? "positive" : "negative");
             for (k = 0; k < MOT_MAX_AXES; k++) {
@@ -611,19 +612,19 @@ static void run_teleop(double dt)
         }
     }
     mot->carte_pos_cmd = p;
-    set_joint_cmds(jt, dt);
+    set_joint_cmds(mot, jt, dt);
     for (i = 0; i < nk; i++)
         mot->joints[i].coarse_pos = mot->joints[i].pos_cmd;
 }
 
-void mot_line_clear(void)
+void mot_line_clear(mot_t *mot)
 {
     mot->line_head = mot->line_count = 0;
     mot->program_line = 0;
     mot->move_req_vel = 0.0;
 }
 
-void mot_line_push(int id, int line, double vel)
+void mot_line_push(mot_t *mot, int id, int line, double vel)
 {
     if (mot->line_count == MOT_LINE_FIFO) {     /* forget the oldest */
         mot->line_head = (mot->line_head + 1) % MOT_LINE_FIFO;
@@ -637,12 +638,12 @@ void mot_line_push(int id, int line, double vel)
 /* follow the planner's exec_id through the remembered moves: the line
    and requested velocity of the move that runs (merged or skipped moves
    are passed over, up to 256 at a time) */
-static void line_track(const tp_state_t *st)
+static void line_track(mot_t *mot, const tp_state_t *st)
 {
     int k;
 
     if (st->done && st->queue_depth == 0) {
-        mot_line_clear();
+        mot_line_clear(mot);
         return;
     }
     for (k = 0; k < mot->line_count && k < 256; k++) {
@@ -658,9 +659,9 @@ static void line_track(const tp_state_t *st)
     }
 }
 
-static void run_coord(double dt)
+static void run_coord(mot_t *mot, double dt)
 {
-    int i, nk = used_kins_joints();
+    int i, nk = used_kins_joints(mot);
     double jt[KINS_MAX_JOINTS], frac;
     EmcPose p;
     const halsdk_tp_api_t *tp = mot->tp;
@@ -714,7 +715,7 @@ static void run_coord(double dt)
         mot->par->active_tc = st.active_moves > 0 ? st.active_moves
                               : (st.queue_depth > 0 ? 1 : 0);
         mot->tp_spindle_wait = st.waiting;
-        line_track(&st);
+        line_track(mot, &st);
         r = tp->probe_result(&pr);
         if (r == 1 && !mot->probe_tripped) {
             mot->probe_tripped = 1;
@@ -722,14 +723,14 @@ static void run_coord(double dt)
         }
         e = tp->take_error();
         if (e && e[0])
-            mot_post("%s", e);
+            mot_post(mot, "%s", e);
         /* joint coarse positions of the planner's new point */
         for (i = 0; i < KINS_MAX_JOINTS; i++)
             jt[i] = i < mot->num_joints ? mot->joints[i].coarse_pos : 0.0;
-        if (mot_inverse(&mot->coarse_next, jt) != 0) {
-            mot_post("coord: inverse kinematics failed at the planned "
+        if (mot_inverse(mot, &mot->coarse_next, jt) != 0) {
+            mot_post(mot, "coord: inverse kinematics failed at the planned "
                      "position: motion disabled");
-            fault();
+            fault(mot);
             return;
         }
         for (i = 0; i < nk; i++) {
@@ -740,11 +741,11 @@ static void run_coord(double dt)
                 /* (the end points were checked against the axis limits;
                    this catches joint limits of non-trivial kinematics)
                    stop here, once: a fault */
-                mot_post("coord move would take joint %d past its %s soft "
-                         "limit: motion disabled", i,
+                mot_post(mot, "coord move would take joint %d past its %s "
+                         "soft limit: motion disabled", i,
                          jt[i] > j->max_pos_limit ? "positive" : "negative");
                 mot->coarse_next = mot->coarse_prev;
-                fault();
+                fault(mot);
                 return;
             }
         }
@@ -767,21 +768,21 @@ static void run_coord(double dt)
     } else {
         for (i = 0; i < KINS_MAX_JOINTS; i++)
             jt[i] = i < mot->num_joints ? mot->joints[i].pos_cmd : 0.0;
-        if (mot_inverse(&p, jt) != 0) {
-            mot_post("coord: inverse kinematics failed: motion disabled");
-            fault();
+        if (mot_inverse(mot, &p, jt) != 0) {
+            mot_post(mot, "coord: inverse kinematics failed: motion disabled");
+            fault(mot);
             return;
         }
     }
     mot->carte_pos_cmd = p;
-    set_joint_cmds(jt, dt);
+    set_joint_cmds(mot, jt, dt);
 }
 
-static void write_pins(double dt, long period);
+static void write_pins(mot_t *mot, double dt, long period);
 
 /* feed hold (when enabled: M53), feed inhibit and adaptive feed (when
    enabled: M52) for this cycle */
-static void read_feed_inputs(void)
+static void read_feed_inputs(mot_t *mot)
 {
     double af = *mot->mp->adaptive_feed;
 
@@ -797,7 +798,7 @@ static void read_feed_inputs(void)
 }
 
 /* the spindle's commanded speed in rpm (signed), CSS included */
-static double spindle_rpm(int n)
+static double spindle_rpm(mot_t *mot, int n)
 {
     mot_spindle_t *sp = &mot->spindle[n];
     double rpm = sp->speed, r;
@@ -816,7 +817,7 @@ static double spindle_rpm(int n)
 }
 
 /* spindles: amplifier faults, the orient handshake, the output pins */
-static void run_spindles(void)
+static void run_spindles(mot_t *mot)
 {
     int n;
 
@@ -829,22 +830,23 @@ static void run_spindles(void)
            while it is true */
         sp->amp_fault = *p->amp_fault_in ? 1 : 0;
         if (sp->amp_fault && mot->enabled) {
-            mot_post("spindle %d amplifier fault (spindle.%d.amp-fault-in): "
-                     "motion disabled", n, n);
-            fault();
+            mot_post(mot, "spindle %d amplifier fault "
+                     "(spindle.%d.amp-fault-in): motion disabled", n, n);
+            fault(mot);
         }
         if (sp->orient_state == MOT_ORIENT_RUNNING) {
             if (*p->orient_fault != 0) {
                 sp->orient_fault = *p->orient_fault;
                 sp->orient_state = MOT_ORIENT_FAULT;
-                mot_post("spindle %d orient failed: spindle.%d.orient-fault "
-                         "is %d", n, n, sp->orient_fault);
+                mot_post(mot, "spindle %d orient failed: "
+                         "spindle.%d.orient-fault is %d", n, n,
+                         sp->orient_fault);
             } else if (*p->is_oriented) {
                 sp->orient_state = MOT_ORIENT_DONE;
                 sp->brake = 1;
             }
         }
-        rpm = spindle_rpm(n);
+        rpm = spindle_rpm(mot, n);
         if (sp->reversed)
             rpm = -rpm;                 /* rigid tap: coming back out */
         *p->speed_cmd_rps = rpm / 60.0;
@@ -869,14 +871,14 @@ static void run_spindles(void)
 
 void mot_controller(void *arg, long period)
 {
+    mot_t *mot = arg;
     int i, homing;
     double dt = period > 0 ? period * 1e-9 : mot->servo_period;
     const char *e;
     EmcPose old_carte = mot->carte_pos_cmd;
 
-    (void)arg;
     mot->heartbeat++;
-    read_inputs();
+    read_inputs(mot);
     mot->home->read_inputs();
 
     /* homing first: in the cycle an encoder resets at the index, homing
@@ -885,10 +887,10 @@ void mot_controller(void *arg, long period)
     homing = mot->home->run();
     e = mot->home->take_error();
     if (e && e[0])
-        mot_post("%s", e);
-    refresh_home_cache();
-    check_faults();
-    read_feed_inputs();
+        mot_post(mot, "%s", e);
+    refresh_home_cache(mot);
+    check_faults(mot);
+    read_feed_inputs(mot);
 
     if (!mot->enabled) {
         /* commands follow the feedback */
@@ -900,7 +902,7 @@ void mot_controller(void *arg, long period)
             fp_reset(&j->free_tp, j->pos_cmd);
             mot->jog_kind[i] = MOT_JOG_NONE;
         }
-        carte_cmd_from_joints();
+        carte_cmd_from_joints(mot);
         for (i = 0; i < MOT_MAX_AXES; i++) {
             fp_reset(&mot->axis[i].tp, *emcpose_axis(&mot->carte_pos_cmd, i));
             mot->axis[i].jog = MOT_JOG_NONE;
@@ -928,21 +930,21 @@ void mot_controller(void *arg, long period)
         }
     } else if (mot->mode == MOT_MODE_FREE) {
         for (i = 0; i < mot->num_joints; i++)
-            run_free_joint(i, dt);
-        carte_cmd_from_joints();
+            run_free_joint(mot, i, dt);
+        carte_cmd_from_joints(mot);
         for (i = 0; i < MOT_MAX_AXES; i++) {
             mot->axis[i].vel_cmd = 0;
             fp_reset(&mot->axis[i].tp, *emcpose_axis(&mot->carte_pos_cmd, i));
         }
     } else {
         /* extra joints keep their free planners in every mode */
-        for (i = used_kins_joints(); i < mot->num_joints; i++)
-            if (is_extra(i) || i >= mot->num_joints_used)
-                run_free_joint(i, dt);
+        for (i = used_kins_joints(mot); i < mot->num_joints; i++)
+            if (is_extra(mot, i) || i >= mot->num_joints_used)
+                run_free_joint(mot, i, dt);
         if (mot->mode == MOT_MODE_TELEOP)
-            run_teleop(dt);
+            run_teleop(mot, dt);
         else
-            run_coord(dt);
+            run_coord(mot, dt);
     }
     (void)homing;
 
@@ -969,7 +971,7 @@ void mot_controller(void *arg, long period)
     /* outputs: compensation, motor command */
     for (i = 0; i < mot->num_joints; i++) {
         mot_joint_t *j = &mot->joints[i];
-        if (posthome_joint(i)) {
+        if (posthome_joint(mot, i)) {
             /* posthome-cmd plus the motor offset, feedback ignored */
             j->backlash_corr = j->backlash_filt = j->backlash_vel = 0.0;
             j->motor_pos_cmd = j->pos_cmd + j->motor_offset;
@@ -977,7 +979,7 @@ void mot_controller(void *arg, long period)
             j->ferror = 0.0;
             continue;
         }
-        mot_comp_joint(i, dt);
+        mot_comp_joint(mot, i, dt);
         j->motor_pos_cmd = j->pos_cmd + j->backlash_filt + j->motor_offset;
         j->ferror_limit = ferror_limit(j);
     }
@@ -989,24 +991,24 @@ void mot_controller(void *arg, long period)
     if (mot->kins_type == KINEMATICS_INVERSE_ONLY) {
         mot->carte_fb_ok = 0;
         mot->carte_pos_fb = mot->carte_pos_cmd;
-    } else if (kins_valid()) {
+    } else if (kins_valid(mot)) {
         double jt[MOT_MAX_JOINTS];
         EmcPose p;
         for (i = 0; i < mot->num_joints; i++)
             jt[i] = mot->joints[i].pos_fb;
-        mot->carte_fb_ok = mot_forward(jt, &p) == 0;
+        mot->carte_fb_ok = mot_forward(mot, jt, &p) == 0;
         mot->carte_pos_fb = mot->carte_fb_ok ? p : mot->carte_pos_cmd;
     } else {
         mot->carte_fb_ok = 0;
     }
 
-    run_spindles();
-    write_pins(dt, period);
+    run_spindles(mot);
+    write_pins(mot, dt, period);
     mot->home->write_outputs();
-    mot_write_status();
+    mot_write_status(mot);
 }
 
-static void write_pins(double dt, long period)
+static void write_pins(mot_t *mot, double dt, long period)
 {
     int i, inpos = 1, soft = 0, jogging = 0;
     mot_motion_pins_t *mp = mot->mp;
@@ -1145,7 +1147,7 @@ static void write_pins(double dt, long period)
                         ? mot->tp->distance_to_go() : 0.0;
 }
 
-void mot_write_status(void)
+void mot_write_status(mot_t *mot)
 {
     mot_channel_t *ch = mot->chan;
     mot_status_t *s;

@@ -243,6 +243,10 @@ typedef struct {
     long long chan_handle;
     mot_channel_t *chan;
     uint32_t last_seq;          /* last command sequence taken */
+    char *why;                  /* where a command handler writes why it
+                                   refuses (the echo's reason, or a
+                                   buffer of the queue) */
+    int whylen;
 
     /* state */
     int mode;                   /* enum mot_mode */
@@ -318,36 +322,44 @@ typedef struct {
     mot_params_t *par;
 } mot_t;
 
-extern mot_t *mot;
+/*
+ * The state is passed explicitly: every function below takes the mot_t
+ * it works on.  The two HAL functions get it as their arg (hal_export_funct
+ * is given the mot_t); only motmod.c keeps a pointer of its own, for
+ * loading and unloading and for the planner hooks (tp_hooks_t), whose
+ * signatures carry no context.
+ */
 
-/* mot_command.c */
+/* mot_command.c: the HAL function motion-command-handler (arg: mot_t) */
 void mot_command_handler(void *arg, long period);
-/* drop the queued records not taken yet (ABORT, DISABLE, faults) */
-void mot_queue_drop(void);
-/* spindles off and released (DISABLE, faults) */
-void mot_spindles_stop(void);
+/* mot_cmd_queue.c: drop the queued records not taken yet (ABORT,
+   DISABLE, faults) */
+void mot_queue_drop(mot_t *mot);
+/* mot_cmd_spindle.c: spindles off and released (DISABLE, faults) */
+void mot_spindles_stop(mot_t *mot);
 
 #define MOT_LINE_FIFO 8192     /* moves remembered (>= the planner queue) */
 
-/* mot_control.c */
+/* mot_control.c: the HAL function motion-controller (arg: mot_t) */
 void mot_controller(void *arg, long period);
-void mot_line_push(int id, int line, double vel);
-void mot_line_clear(void);
+void mot_line_push(mot_t *mot, int id, int line, double vel);
+void mot_line_clear(mot_t *mot);
 /* write the status snapshot of the channel (seqlock) */
-void mot_write_status(void);
+void mot_write_status(mot_t *mot);
 /* post an error message into the channel ring (and print it) */
-void mot_post(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+void mot_post(mot_t *mot, const char *fmt, ...)
+    __attribute__((format(printf, 2, 3)));
 /* stop everything: DISABLE and the faults */
-void mot_disable(void);
+void mot_disable(mot_t *mot);
 /* put the planners of the current mode at the present positions */
-void mot_sync_planners(void);
+void mot_sync_planners(mot_t *mot);
 /* planner profile and limits of joint / axis from the configuration */
-void mot_joint_limits_to_planner(int j);
-void mot_axis_limits_to_planner(int a);
-int mot_all_homed(void);
-int mot_moving(void);           /* anything moves (not in position) */
+void mot_joint_limits_to_planner(mot_t *mot, int j);
+void mot_axis_limits_to_planner(mot_t *mot, int a);
+int mot_all_homed(mot_t *mot);
+int mot_moving(mot_t *mot);     /* anything moves (not in position) */
 /* forward/inverse kinematics over the joints in use */
-int mot_forward(const double *joints, EmcPose *pos);
-int mot_inverse(const EmcPose *pos, double *joints);
+int mot_forward(mot_t *mot, const double *joints, EmcPose *pos);
+int mot_inverse(mot_t *mot, const EmcPose *pos, double *joints);
 
 #endif

@@ -53,7 +53,11 @@ static int num_extrajoints = 0;
 RTAPI_MP_INT(num_extrajoints,
              "extra joints, not used by kinematics (0..num_joints)");
 
-mot_t *mot;
+/* the state of this module.  Loading and unloading use it, and so do the
+   planner hooks below: tp_hooks_t callbacks carry no context argument.
+   Everything else gets it as an argument (the HAL functions as their
+   arg). */
+static mot_t *mot;
 
 static int comp_id = -1;
 static int made_servo_thread, made_base_thread;
@@ -584,10 +588,11 @@ int rtapi_app_main(void)
     __atomic_store_n(&mot->chan->magic, MOT_CHANNEL_MAGIC, __ATOMIC_RELEASE);
 
     /* functions */
+    /* both get the state as their arg */
     r = hal_export_funct("motion-command-handler", mot_command_handler,
-                         NULL, 1, 0, comp_id);
+                         mot, 1, 0, comp_id);
     if (r == 0)
-        r = hal_export_funct("motion-controller", mot_controller, NULL, 1,
+        r = hal_export_funct("motion-controller", mot_controller, mot, 1,
                              0, comp_id);
     if (r < 0) {
         rtapi_print_msg(RTAPI_MSG_ERR, "motmod: exporting the functions "
@@ -617,8 +622,8 @@ int rtapi_app_main(void)
     }
     made_servo_thread = 1;
 
-    mot_sync_planners();
-    mot_write_status();
+    mot_sync_planners(mot);
+    mot_write_status(mot);
     hal_ready(comp_id);
     return 0;
 

@@ -335,7 +335,7 @@ cdef object coerce(int type, value, str what, bint wrap=False):
     """halsdk.values.coerce (imported on first use: it imports us)."""
     global _values
     if _values is None:
-        from halsdk import values
+        from halsdk.core import values
         _values = values
     return _values.coerce(type, value, what, wrap)
 

@@ -13,13 +13,10 @@ import re
 import signal
 import threading
 import time
-from typing import TYPE_CHECKING, Callable, Optional
+from typing import Any, Callable, Optional
 
 from halsdk.core import _core
 from halsdk.core.errors import ExistsError, InstanceError, InvalidError
-
-if TYPE_CHECKING:
-    from halsdk.loader import Registry
 
 _INSTANCE_NAME = re.compile(r"^[A-Za-z0-9_.-]{1,40}$")
 SHM_DIR = "/dev/shm"
@@ -59,9 +56,10 @@ class Connection:
         self.closers: list[Callable[[], None]] = []
         self.server = None              # request channel, on the host
         self.handlers: dict[str, Callable] = {}   # requests it serves
-        # the host's realtime modules (halsdk.loader.Registry), made by
-        # the first Hal of the host process
-        self.registry: Optional[Registry] = None
+        # the host's realtime modules: a halsdk.loader.Registry that the
+        # first Hal of the host process makes (the core does not know the
+        # loader, the layer above it)
+        self.registry: Any = None
         self.lock = threading.RLock()
 
     @property

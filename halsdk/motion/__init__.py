@@ -14,32 +14,45 @@ See docs/motion.rst for the commands and the status.
 """
 
 from halsdk.motion.client import (
-    Cmd,
     InputWait,
     Motion,
     MotionError,
     MotionTimeout,
     QueueRejected,
     Rejected,
-    homing_fields,
 )
-from halsdk.motion.ini import MotionConfig, MotionIniError, read_motion_ini
-from halsdk.motion.status import (
-    AxisStatus,
-    JointStatus,
+from halsdk.motion.ini import (
+    MotionConfig,
+    MotionIniError,
+    homing_fields,
+    read_motion_ini,
+)
+from halsdk.motion.protocol import (
+    HOME_SEQUENCE_NONE,
+    Cmd,
+    Echo,
+    HomeFlag,
+    JointFlag,
     KinsType,
     Mode,
     MotionType,
     OrientState,
-    Pose,
+    ProbeFlag,
     Profile,
+    TermCond,
+)
+from halsdk.motion.status import (
+    AxisStatus,
+    JointStatus,
+    Pose,
     SpindleStatus,
     Status,
-    TermCond,
 )
 
 __all__ = ["Motion", "Rejected", "QueueRejected", "MotionError",
-           "MotionTimeout", "Cmd", "InputWait", "Status", "JointStatus",
-           "AxisStatus", "SpindleStatus", "OrientState", "Mode", "KinsType",
-           "MotionType", "Profile", "TermCond", "Pose", "homing_fields",
-           "MotionConfig", "MotionIniError", "read_motion_ini"]
+           "MotionTimeout", "Cmd", "Echo", "InputWait", "Status",
+           "JointStatus", "AxisStatus", "SpindleStatus", "OrientState",
+           "Mode", "KinsType", "MotionType", "Profile", "TermCond", "Pose",
+           "HomeFlag", "JointFlag", "ProbeFlag", "HOME_SEQUENCE_NONE",
+           "homing_fields", "MotionConfig", "MotionIniError",
+           "read_motion_ini"]

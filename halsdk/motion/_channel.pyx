@@ -7,9 +7,12 @@ This module only moves bytes with the right memory ordering; waiting,
 timeouts and decoding belong to :mod:`halsdk.motion.client`.
 """
 
-from cpython.pycapsule cimport PyCapsule_GetPointer
 from libc.stdint cimport int32_t, uint32_t, uint64_t, uintptr_t
+from libc.stdlib cimport calloc, free
 from libc.string cimport memcpy, memset
+
+from halsdk.errors import InstanceError
+from halsdk.hal import Hal
 
 cdef extern from *:
     """
@@ -61,6 +64,8 @@ cdef extern from "halsdk_api.h":
         long long (*shmem_attach)(const char *name)
         void *(*shmem_ptr)(long long handle)
         long (*shmem_size)(long long handle)
+    const halsdk_api *halsdk_api_ptr
+    int import_halsdk() except -1
 
 cdef extern from "emcpose.h":
     ctypedef struct PmCartesian:
@@ -70,9 +75,19 @@ cdef extern from "emcpose.h":
         double a, b, c, u, v, w
 
 cdef extern from "channel.h":
-    int MOT_CHANNEL_MAGIC, MOT_CHANNEL_VERSION, MOT_MAX_JOINTS
-    int MOT_MAX_AXES, MOT_REASON_LEN, MOT_MSG_LEN, MOT_MSG_RING
-    int MOT_QUEUE_SIZE, MOT_MAX_SPINDLES, MOT_MAX_AIO
+    enum:
+        MOT_CHANNEL_MAGIC
+        MOT_CHANNEL_VERSION
+        MOT_MAX_JOINTS
+        MOT_MAX_AXES
+        MOT_REASON_LEN
+        MOT_MSG_LEN
+        MOT_MSG_RING
+        MOT_QUEUE_SIZE
+        MOT_MAX_SPINDLES
+        MOT_MAX_AIO
+
+    # (the array sizes below are the headers' #defines)
 
     ctypedef struct mot_command_t:
         int32_t cmd, joint, axis, ival, index, id, motion_type, turn
@@ -125,37 +140,527 @@ cdef extern from "channel.h":
         int32_t carte_pos_fb_ok
         EmcPose probed_pos, tool_offset
         uint64_t dout, din
-        mot_joint_status_t joint[16]
-        mot_axis_status_t axis[9]
+        mot_joint_status_t joint[MOT_MAX_JOINTS]
+        mot_axis_status_t axis[MOT_MAX_AXES]
         int32_t program_line, feed_hold_enabled, adaptive_enabled
         int32_t feed_hold, feed_inhibit, queue_taken
         uint32_t queue_err_count
         double adaptive_feed, feed_upm, linear_units
-        double ain[64]
-        double aout[64]
-        mot_spindle_status_t spindle[8]
+        double ain[MOT_MAX_AIO]
+        double aout[MOT_MAX_AIO]
+        mot_spindle_status_t spindle[MOT_MAX_SPINDLES]
         int32_t spindle_wait, queue_held
 
     ctypedef struct mot_msg_t:
         uint64_t n
-        char text[200]
+        char text[MOT_MSG_LEN]
 
     ctypedef struct mot_channel_t:
         uint32_t magic, version, size
         int32_t lock_pid
         uint32_t cmd_seq, echo_seq
         int32_t echo_status, echo_cmd
-        char echo_reason[200]
+        char echo_reason[MOT_REASON_LEN]
         mot_command_t command
         uint32_t status_seq
         mot_status_t status
         uint64_t msg_count
-        mot_msg_t msgs[32]
+        mot_msg_t msgs[MOT_MSG_RING]
         uint32_t q_head, q_tail, q_err_count
         int32_t q_err_cmd, q_err_id, q_err_line
-        char q_err_reason[200]
-        mot_command_t queue[1]
+        char q_err_reason[MOT_REASON_LEN]
+        mot_command_t queue[MOT_QUEUE_SIZE]
 
+
+# ------------------------------------------------------------ protocol
+# The numbers of the protocol, taken from the headers when this module is
+# compiled: halsdk.motion.protocol builds its enums from the dicts below
+# (name without prefix -> value), so no number is typed twice.
+
+cdef extern from "channel.h":
+    enum:
+        MOT_CMD_NONE
+        MOT_CMD_ABORT
+        MOT_CMD_FREE
+        MOT_CMD_TELEOP
+        MOT_CMD_COORD
+        MOT_CMD_ENABLE
+        MOT_CMD_DISABLE
+        MOT_CMD_ENABLE_AMPLIFIER
+        MOT_CMD_DISABLE_AMPLIFIER
+        MOT_CMD_ACTIVATE_JOINT
+        MOT_CMD_DEACTIVATE_JOINT
+        MOT_CMD_PAUSE
+        MOT_CMD_RESUME
+        MOT_CMD_STEP
+        MOT_CMD_SCALE
+        MOT_CMD_RAPID_SCALE
+        MOT_CMD_OVERRIDE_LIMITS
+        MOT_CMD_HOME
+        MOT_CMD_UNHOME
+        MOT_CMD_JOG_CONT
+        MOT_CMD_JOG_INCR
+        MOT_CMD_JOG_ABS
+        MOT_CMD_JOG_STOP
+        MOT_CMD_SET_LINE
+        MOT_CMD_SET_CIRCLE
+        MOT_CMD_SET_TELEOP_VECTOR
+        MOT_CMD_PROBE
+        MOT_CMD_CLEAR_PROBE_FLAG
+        MOT_CMD_SET_NUM_JOINTS
+        MOT_CMD_SET_JOINT_POSITION_LIMITS
+        MOT_CMD_SET_JOINT_VEL_LIMIT
+        MOT_CMD_SET_JOINT_ACC_LIMIT
+        MOT_CMD_SET_JOINT_JERK_LIMIT
+        MOT_CMD_SET_JOINT_MIN_FERROR
+        MOT_CMD_SET_JOINT_MAX_FERROR
+        MOT_CMD_SET_JOINT_HOMING_PARAMS
+        MOT_CMD_SET_JOINT_BACKLASH
+        MOT_CMD_SET_JOINT_COMP
+        MOT_CMD_CLEAR_JOINT_COMP
+        MOT_CMD_SET_JOINT_MOTOR_OFFSET
+        MOT_CMD_SET_AXIS_POSITION_LIMITS
+        MOT_CMD_SET_AXIS_VEL_LIMIT
+        MOT_CMD_SET_AXIS_ACC_LIMIT
+        MOT_CMD_SET_AXIS_JERK_LIMIT
+        MOT_CMD_SET_VEL
+        MOT_CMD_SET_VEL_LIMIT
+        MOT_CMD_SET_ACC
+        MOT_CMD_SET_TERM_COND
+        MOT_CMD_SET_OFFSET
+        MOT_CMD_SET_PROFILE
+        MOT_CMD_SET_DOUT
+        MOT_CMD_SET_AOUT
+        MOT_CMD_SET_FEED_HOLD_ENABLE
+        MOT_CMD_SET_ADAPTIVE_FEED_ENABLE
+        MOT_CMD_SET_LINEAR_UNITS
+        MOT_CMD_SPINDLE_ON
+        MOT_CMD_SPINDLE_OFF
+        MOT_CMD_SPINDLE_INCREASE
+        MOT_CMD_SPINDLE_DECREASE
+        MOT_CMD_SPINDLE_ORIENT
+        MOT_CMD_SPINDLE_BRAKE_ENGAGE
+        MOT_CMD_SPINDLE_BRAKE_RELEASE
+        MOT_CMD_SPINDLE_SYNC_LINE
+        MOT_CMD_RIGID_TAP
+        MOT_CMD_RESERVED_FIRST
+        MOT_CMD_RESERVED_LAST
+        MOT_CMD_LAST
+        MOT_ECHO_NONE
+        MOT_ECHO_DONE
+        MOT_ECHO_ACCEPTED
+        MOT_ECHO_REJECTED
+        MOT_MODE_FREE
+        MOT_MODE_TELEOP
+        MOT_MODE_COORD
+        MOT_TERM_STOP
+        MOT_TERM_EXACT
+        MOT_TERM_BLEND
+        MOT_MOTION_NONE
+        MOT_MOTION_TRAVERSE
+        MOT_MOTION_FEED
+        MOT_MOTION_ARC
+        MOT_MOTION_TOOLCHANGE
+        MOT_MOTION_PROBING
+        MOT_MOTION_INDEXROTARY
+        MOT_KINS_IDENTITY
+        MOT_KINS_FORWARD_ONLY
+        MOT_KINS_INVERSE_ONLY
+        MOT_KINS_BOTH
+        MOT_ORIENT_NONE
+        MOT_ORIENT_RUNNING
+        MOT_ORIENT_DONE
+        MOT_ORIENT_FAULT
+        MOT_PROBE_NO_ERROR
+        MOT_PROBE_AWAY
+
+cdef extern from "homing.h":
+    enum:
+        HOME_IGNORE_LIMITS
+        HOME_USE_INDEX
+        HOME_IS_SHARED
+        HOME_UNLOCK_FIRST
+        HOME_ABSOLUTE_ENCODER
+        HOME_NO_REHOME
+        HOME_NO_FINAL_MOVE
+        HOME_INDEX_NO_ENCODER_RESET
+        HOME_SEQUENCE_NONE
+
+cdef extern from "mot_joint.h":
+    enum:
+        MOT_JOINT_ACTIVE
+        MOT_JOINT_ENABLED
+        MOT_JOINT_INPOS
+        MOT_JOINT_ERROR
+        MOT_JOINT_POS_SOFT
+        MOT_JOINT_NEG_SOFT
+        MOT_JOINT_POS_HARD
+        MOT_JOINT_NEG_HARD
+        MOT_JOINT_FERROR
+        MOT_JOINT_FAULT
+        MOT_JOINT_HOMING
+        MOT_JOINT_HOMED
+
+cdef extern from "freeplan.h":
+    enum:
+        FP_TRAPEZOID
+        FP_JERK
+
+
+# the names above, in dicts (name without its prefix -> value)
+CMD = {"ABORT": MOT_CMD_ABORT, "FREE": MOT_CMD_FREE, "TELEOP": MOT_CMD_TELEOP,
+       "COORD": MOT_CMD_COORD, "ENABLE": MOT_CMD_ENABLE,
+       "DISABLE": MOT_CMD_DISABLE,
+       "ENABLE_AMPLIFIER": MOT_CMD_ENABLE_AMPLIFIER,
+       "DISABLE_AMPLIFIER": MOT_CMD_DISABLE_AMPLIFIER,
+       "ACTIVATE_JOINT": MOT_CMD_ACTIVATE_JOINT,
+       "DEACTIVATE_JOINT": MOT_CMD_DEACTIVATE_JOINT, "PAUSE": MOT_CMD_PAUSE,
+       "RESUME": MOT_CMD_RESUME, "STEP": MOT_CMD_STEP, "SCALE": MOT_CMD_SCALE,
+       "RAPID_SCALE": MOT_CMD_RAPID_SCALE,
+       "OVERRIDE_LIMITS": MOT_CMD_OVERRIDE_LIMITS, "HOME": MOT_CMD_HOME,
+       "UNHOME": MOT_CMD_UNHOME, "JOG_CONT": MOT_CMD_JOG_CONT,
+       "JOG_INCR": MOT_CMD_JOG_INCR, "JOG_ABS": MOT_CMD_JOG_ABS,
+       "JOG_STOP": MOT_CMD_JOG_STOP, "SET_LINE": MOT_CMD_SET_LINE,
+       "SET_CIRCLE": MOT_CMD_SET_CIRCLE,
+       "SET_TELEOP_VECTOR": MOT_CMD_SET_TELEOP_VECTOR, "PROBE": MOT_CMD_PROBE,
+       "CLEAR_PROBE_FLAG": MOT_CMD_CLEAR_PROBE_FLAG,
+       "SET_NUM_JOINTS": MOT_CMD_SET_NUM_JOINTS,
+       "SET_JOINT_POSITION_LIMITS": MOT_CMD_SET_JOINT_POSITION_LIMITS,
+       "SET_JOINT_VEL_LIMIT": MOT_CMD_SET_JOINT_VEL_LIMIT,
+       "SET_JOINT_ACC_LIMIT": MOT_CMD_SET_JOINT_ACC_LIMIT,
+       "SET_JOINT_JERK_LIMIT": MOT_CMD_SET_JOINT_JERK_LIMIT,
+       "SET_JOINT_MIN_FERROR": MOT_CMD_SET_JOINT_MIN_FERROR,
+       "SET_JOINT_MAX_FERROR": MOT_CMD_SET_JOINT_MAX_FERROR,
+       "SET_JOINT_HOMING_PARAMS": MOT_CMD_SET_JOINT_HOMING_PARAMS,
+       "SET_JOINT_BACKLASH": MOT_CMD_SET_JOINT_BACKLASH,
+       "SET_JOINT_COMP": MOT_CMD_SET_JOINT_COMP,
+       "CLEAR_JOINT_COMP": MOT_CMD_CLEAR_JOINT_COMP,
+       "SET_JOINT_MOTOR_OFFSET": MOT_CMD_SET_JOINT_MOTOR_OFFSET,
+       "SET_AXIS_POSITION_LIMITS": MOT_CMD_SET_AXIS_POSITION_LIMITS,
+       "SET_AXIS_VEL_LIMIT": MOT_CMD_SET_AXIS_VEL_LIMIT,
+       "SET_AXIS_ACC_LIMIT": MOT_CMD_SET_AXIS_ACC_LIMIT,
+       "SET_AXIS_JERK_LIMIT": MOT_CMD_SET_AXIS_JERK_LIMIT,
+       "SET_VEL": MOT_CMD_SET_VEL, "SET_VEL_LIMIT": MOT_CMD_SET_VEL_LIMIT,
+       "SET_ACC": MOT_CMD_SET_ACC, "SET_TERM_COND": MOT_CMD_SET_TERM_COND,
+       "SET_OFFSET": MOT_CMD_SET_OFFSET, "SET_PROFILE": MOT_CMD_SET_PROFILE,
+       "SET_DOUT": MOT_CMD_SET_DOUT, "SET_AOUT": MOT_CMD_SET_AOUT,
+       "SET_FEED_HOLD_ENABLE": MOT_CMD_SET_FEED_HOLD_ENABLE,
+       "SET_ADAPTIVE_FEED_ENABLE": MOT_CMD_SET_ADAPTIVE_FEED_ENABLE,
+       "SET_LINEAR_UNITS": MOT_CMD_SET_LINEAR_UNITS,
+       "SPINDLE_ON": MOT_CMD_SPINDLE_ON, "SPINDLE_OFF": MOT_CMD_SPINDLE_OFF,
+       "SPINDLE_INCREASE": MOT_CMD_SPINDLE_INCREASE,
+       "SPINDLE_DECREASE": MOT_CMD_SPINDLE_DECREASE,
+       "SPINDLE_ORIENT": MOT_CMD_SPINDLE_ORIENT,
+       "SPINDLE_BRAKE_ENGAGE": MOT_CMD_SPINDLE_BRAKE_ENGAGE,
+       "SPINDLE_BRAKE_RELEASE": MOT_CMD_SPINDLE_BRAKE_RELEASE,
+       "SPINDLE_SYNC_LINE": MOT_CMD_SPINDLE_SYNC_LINE,
+       "RIGID_TAP": MOT_CMD_RIGID_TAP}
+ECHO = {"NONE": MOT_ECHO_NONE, "DONE": MOT_ECHO_DONE,
+        "ACCEPTED": MOT_ECHO_ACCEPTED, "REJECTED": MOT_ECHO_REJECTED}
+MODE = {"FREE": MOT_MODE_FREE, "TELEOP": MOT_MODE_TELEOP,
+        "COORD": MOT_MODE_COORD}
+TERM = {"STOP": MOT_TERM_STOP, "EXACT": MOT_TERM_EXACT,
+        "BLEND": MOT_TERM_BLEND}
+MOTION_TYPE = {"NONE": MOT_MOTION_NONE, "TRAVERSE": MOT_MOTION_TRAVERSE,
+               "FEED": MOT_MOTION_FEED, "ARC": MOT_MOTION_ARC,
+               "TOOLCHANGE": MOT_MOTION_TOOLCHANGE,
+               "PROBING": MOT_MOTION_PROBING,
+               "INDEXROTARY": MOT_MOTION_INDEXROTARY}
+KINS_TYPE = {"IDENTITY": MOT_KINS_IDENTITY,
+             "FORWARD_ONLY": MOT_KINS_FORWARD_ONLY,
+             "INVERSE_ONLY": MOT_KINS_INVERSE_ONLY, "BOTH": MOT_KINS_BOTH}
+ORIENT_STATE = {"NONE": MOT_ORIENT_NONE, "RUNNING": MOT_ORIENT_RUNNING,
+                "DONE": MOT_ORIENT_DONE, "FAULT": MOT_ORIENT_FAULT}
+PROBE = {"NO_ERROR": MOT_PROBE_NO_ERROR, "AWAY": MOT_PROBE_AWAY}
+HOME_FLAGS = {"IGNORE_LIMITS": HOME_IGNORE_LIMITS, "USE_INDEX": HOME_USE_INDEX,
+              "IS_SHARED": HOME_IS_SHARED, "UNLOCK_FIRST": HOME_UNLOCK_FIRST,
+              "ABSOLUTE_ENCODER": HOME_ABSOLUTE_ENCODER,
+              "NO_REHOME": HOME_NO_REHOME, "NO_FINAL_MOVE": HOME_NO_FINAL_MOVE,
+              "INDEX_NO_ENCODER_RESET": HOME_INDEX_NO_ENCODER_RESET}
+JOINT_FLAGS = {"ACTIVE": MOT_JOINT_ACTIVE, "ENABLED": MOT_JOINT_ENABLED,
+               "INPOS": MOT_JOINT_INPOS, "ERROR": MOT_JOINT_ERROR,
+               "POS_SOFT": MOT_JOINT_POS_SOFT, "NEG_SOFT": MOT_JOINT_NEG_SOFT,
+               "POS_HARD": MOT_JOINT_POS_HARD, "NEG_HARD": MOT_JOINT_NEG_HARD,
+               "FERROR": MOT_JOINT_FERROR, "FAULT": MOT_JOINT_FAULT,
+               "HOMING": MOT_JOINT_HOMING, "HOMED": MOT_JOINT_HOMED}
+PROFILE = {"TRAPEZOID": FP_TRAPEZOID, "JERK": FP_JERK}
+HOME_SEQ_NONE = HOME_SEQUENCE_NONE
+CMD_LAST = MOT_CMD_LAST     # every command code is below this
+
+
+
+# ------------------------------------------------------------ layout
+# Where the compiler put the fields of the channel's structures (the
+# headers' layout, offsetof): LAYOUT[struct] = (sizeof, fields), the
+# fields in order as (name, offset, kind, count): kind "i32", "u32",
+# "u64", "f64", "char" or another struct of LAYOUT, count > 1 for an
+# array (the headers' sizes).  Padding and reserved fields are left out;
+# a pose is listed by axis letters (x y z a b c u v w).  For tools and
+# tests that look at the block with ctypes; the client uses the typed
+# access above.
+
+cdef tuple _f(str name, const volatile void *base, const volatile void *at,
+              str kind, size_t count=1):
+    return (name, <size_t>(<const volatile char *>at -
+                           <const volatile char *>base), kind, count)
+
+
+cdef tuple _layout_PmCartesian():
+    cdef PmCartesian s
+    cdef void *b = &s
+    return sizeof(s), (
+        _f("x", b, &s.x, "f64"),
+        _f("y", b, &s.y, "f64"),
+        _f("z", b, &s.z, "f64"),
+    )
+
+
+cdef tuple _layout_EmcPose():
+    cdef EmcPose s
+    cdef void *b = &s
+    return sizeof(s), (
+        _f("x", b, &s.tran.x, "f64"),
+        _f("y", b, &s.tran.y, "f64"),
+        _f("z", b, &s.tran.z, "f64"),
+        _f("a", b, &s.a, "f64"),
+        _f("b", b, &s.b, "f64"),
+        _f("c", b, &s.c, "f64"),
+        _f("u", b, &s.u, "f64"),
+        _f("v", b, &s.v, "f64"),
+        _f("w", b, &s.w, "f64"),
+    )
+
+
+cdef tuple _layout_command():
+    cdef mot_command_t s
+    cdef void *b = &s
+    return sizeof(s), (
+        _f("cmd", b, &s.cmd, "i32"),
+        _f("joint", b, &s.joint, "i32"),
+        _f("axis", b, &s.axis, "i32"),
+        _f("ival", b, &s.ival, "i32"),
+        _f("index", b, &s.index, "i32"),
+        _f("id", b, &s.id, "i32"),
+        _f("motion_type", b, &s.motion_type, "i32"),
+        _f("turn", b, &s.turn, "i32"),
+        _f("vel", b, &s.vel, "f64"),
+        _f("ini_maxvel", b, &s.ini_maxvel, "f64"),
+        _f("acc", b, &s.acc, "f64"),
+        _f("jerk", b, &s.jerk, "f64"),
+        _f("offset", b, &s.offset, "f64"),
+        _f("value", b, &s.value, "f64"),
+        _f("min_limit", b, &s.min_limit, "f64"),
+        _f("max_limit", b, &s.max_limit, "f64"),
+        _f("tolerance", b, &s.tolerance, "f64"),
+        _f("comp", b, &s.comp, "f64", 3),
+        _f("pos", b, &s.pos, "EmcPose"),
+        _f("center", b, &s.center, "PmCartesian"),
+        _f("normal", b, &s.normal, "PmCartesian"),
+        _f("home_offset", b, &s.home_offset, "f64"),
+        _f("home", b, &s.home, "f64"),
+        _f("home_search_vel", b, &s.home_search_vel, "f64"),
+        _f("home_latch_vel", b, &s.home_latch_vel, "f64"),
+        _f("home_final_vel", b, &s.home_final_vel, "f64"),
+        _f("home_sequence", b, &s.home_sequence, "i32"),
+        _f("volatile_home", b, &s.volatile_home, "i32"),
+        _f("home_flags", b, &s.home_flags, "u32"),
+        _f("line", b, &s.line, "i32"),
+        _f("epoch", b, &s.epoch, "u32"),
+        _f("sync", b, &s.sync, "i32"),
+        _f("pitch", b, &s.pitch, "f64"),
+    )
+
+
+cdef tuple _layout_spindle_status():
+    cdef mot_spindle_status_t s
+    cdef void *b = &s
+    return sizeof(s), (
+        _f("speed", b, &s.speed, "f64"),
+        _f("speed_in", b, &s.speed_in, "f64"),
+        _f("revs", b, &s.revs, "f64"),
+        _f("orient_angle", b, &s.orient_angle, "f64"),
+        _f("css_factor", b, &s.css_factor, "f64"),
+        _f("on", b, &s.on, "i32"),
+        _f("direction", b, &s.direction, "i32"),
+        _f("brake", b, &s.brake, "i32"),
+        _f("locked", b, &s.locked, "i32"),
+        _f("orient_state", b, &s.orient_state, "i32"),
+        _f("orient_fault", b, &s.orient_fault, "i32"),
+        _f("at_speed", b, &s.at_speed, "i32"),
+        _f("inhibit", b, &s.inhibit, "i32"),
+        _f("amp_fault", b, &s.amp_fault, "i32"),
+    )
+
+
+cdef tuple _layout_joint_status():
+    cdef mot_joint_status_t s
+    cdef void *b = &s
+    return sizeof(s), (
+        _f("flags", b, &s.flags, "u32"),
+        _f("home_state", b, &s.home_state, "i32"),
+        _f("pos_cmd", b, &s.pos_cmd, "f64"),
+        _f("pos_fb", b, &s.pos_fb, "f64"),
+        _f("vel_cmd", b, &s.vel_cmd, "f64"),
+        _f("acc_cmd", b, &s.acc_cmd, "f64"),
+        _f("ferror", b, &s.ferror, "f64"),
+        _f("ferror_limit", b, &s.ferror_limit, "f64"),
+        _f("ferror_high_mark", b, &s.ferror_high_mark, "f64"),
+        _f("motor_offset", b, &s.motor_offset, "f64"),
+        _f("motor_pos_cmd", b, &s.motor_pos_cmd, "f64"),
+        _f("motor_pos_fb", b, &s.motor_pos_fb, "f64"),
+        _f("backlash_filt", b, &s.backlash_filt, "f64"),
+        _f("min_pos_limit", b, &s.min_pos_limit, "f64"),
+        _f("max_pos_limit", b, &s.max_pos_limit, "f64"),
+        _f("vel_limit", b, &s.vel_limit, "f64"),
+        _f("acc_limit", b, &s.acc_limit, "f64"),
+        _f("jerk_limit", b, &s.jerk_limit, "f64"),
+        _f("min_ferror", b, &s.min_ferror, "f64"),
+        _f("max_ferror", b, &s.max_ferror, "f64"),
+        _f("backlash", b, &s.backlash, "f64"),
+        _f("free_target", b, &s.free_target, "f64"),
+        _f("free_active", b, &s.free_active, "i32"),
+        _f("jog_active", b, &s.jog_active, "i32"),
+    )
+
+
+cdef tuple _layout_axis_status():
+    cdef mot_axis_status_t s
+    cdef void *b = &s
+    return sizeof(s), (
+        _f("pos_cmd", b, &s.pos_cmd, "f64"),
+        _f("vel_cmd", b, &s.vel_cmd, "f64"),
+        _f("teleop_pos", b, &s.teleop_pos, "f64"),
+        _f("teleop_vel", b, &s.teleop_vel, "f64"),
+        _f("teleop_target", b, &s.teleop_target, "f64"),
+        _f("min_pos_limit", b, &s.min_pos_limit, "f64"),
+        _f("max_pos_limit", b, &s.max_pos_limit, "f64"),
+        _f("vel_limit", b, &s.vel_limit, "f64"),
+        _f("acc_limit", b, &s.acc_limit, "f64"),
+        _f("jerk_limit", b, &s.jerk_limit, "f64"),
+        _f("teleop_active", b, &s.teleop_active, "i32"),
+        _f("jog_active", b, &s.jog_active, "i32"),
+    )
+
+
+cdef tuple _layout_status():
+    cdef mot_status_t s
+    cdef void *b = &s
+    return sizeof(s), (
+        _f("heartbeat", b, &s.heartbeat, "u64"),
+        _f("mode", b, &s.mode, "i32"),
+        _f("enabled", b, &s.enabled, "i32"),
+        _f("in_position", b, &s.in_position, "i32"),
+        _f("on_soft_limit", b, &s.on_soft_limit, "i32"),
+        _f("override_limits", b, &s.override_limits, "i32"),
+        _f("num_joints", b, &s.num_joints, "i32"),
+        _f("num_joints_loaded", b, &s.num_joints_loaded, "i32"),
+        _f("num_extrajoints", b, &s.num_extrajoints, "i32"),
+        _f("kins_type", b, &s.kins_type, "i32"),
+        _f("homing", b, &s.homing, "i32"),
+        _f("all_homed", b, &s.all_homed, "i32"),
+        _f("paused", b, &s.paused, "i32"),
+        _f("probing", b, &s.probing, "i32"),
+        _f("probe_tripped", b, &s.probe_tripped, "i32"),
+        _f("queue_depth", b, &s.queue_depth, "i32"),
+        _f("motion_id", b, &s.motion_id, "i32"),
+        _f("motion_type", b, &s.motion_type, "i32"),
+        _f("profile", b, &s.profile, "i32"),
+        _f("coord_error", b, &s.coord_error, "i32"),
+        _f("error", b, &s.error, "i32"),
+        _f("num_dio", b, &s.num_dio, "i32"),
+        _f("num_aio", b, &s.num_aio, "i32"),
+        _f("num_spindles", b, &s.num_spindles, "i32"),
+        _f("term_cond", b, &s.term_cond, "i32"),
+        _f("feed_scale", b, &s.feed_scale, "f64"),
+        _f("rapid_scale", b, &s.rapid_scale, "f64"),
+        _f("current_vel", b, &s.current_vel, "f64"),
+        _f("distance_to_go", b, &s.distance_to_go, "f64"),
+        _f("requested_vel", b, &s.requested_vel, "f64"),
+        _f("vel_limit", b, &s.vel_limit, "f64"),
+        _f("acc_limit", b, &s.acc_limit, "f64"),
+        _f("tolerance", b, &s.tolerance, "f64"),
+        _f("servo_period", b, &s.servo_period, "f64"),
+        _f("traj_period", b, &s.traj_period, "f64"),
+        _f("carte_pos_cmd", b, &s.carte_pos_cmd, "EmcPose"),
+        _f("carte_pos_fb", b, &s.carte_pos_fb, "EmcPose"),
+        _f("carte_pos_fb_ok", b, &s.carte_pos_fb_ok, "i32"),
+        _f("probed_pos", b, &s.probed_pos, "EmcPose"),
+        _f("tool_offset", b, &s.tool_offset, "EmcPose"),
+        _f("dout", b, &s.dout, "u64"),
+        _f("din", b, &s.din, "u64"),
+        _f("joint", b, &s.joint, "mot_joint_status_t", MOT_MAX_JOINTS),
+        _f("axis", b, &s.axis, "mot_axis_status_t", MOT_MAX_AXES),
+        _f("program_line", b, &s.program_line, "i32"),
+        _f("feed_hold_enabled", b, &s.feed_hold_enabled, "i32"),
+        _f("adaptive_enabled", b, &s.adaptive_enabled, "i32"),
+        _f("feed_hold", b, &s.feed_hold, "i32"),
+        _f("feed_inhibit", b, &s.feed_inhibit, "i32"),
+        _f("queue_taken", b, &s.queue_taken, "i32"),
+        _f("queue_err_count", b, &s.queue_err_count, "u32"),
+        _f("adaptive_feed", b, &s.adaptive_feed, "f64"),
+        _f("feed_upm", b, &s.feed_upm, "f64"),
+        _f("linear_units", b, &s.linear_units, "f64"),
+        _f("ain", b, &s.ain, "f64", MOT_MAX_AIO),
+        _f("aout", b, &s.aout, "f64", MOT_MAX_AIO),
+        _f("spindle", b, &s.spindle, "mot_spindle_status_t", MOT_MAX_SPINDLES),
+        _f("spindle_wait", b, &s.spindle_wait, "i32"),
+        _f("queue_held", b, &s.queue_held, "i32"),
+    )
+
+
+cdef tuple _layout_msg():
+    cdef mot_msg_t s
+    cdef void *b = &s
+    return sizeof(s), (
+        _f("n", b, &s.n, "u64"),
+        _f("text", b, &s.text, "char", MOT_MSG_LEN),
+    )
+
+
+cdef tuple _layout_channel():
+    # (the block holds the move queue: too large for the stack)
+    cdef mot_channel_t *s = <mot_channel_t *>calloc(1, sizeof(s[0]))
+    cdef void *b = s
+    if s == NULL:
+        raise MemoryError()
+    try:
+        return sizeof(s[0]), (
+            _f("magic", b, &s.magic, "u32"),
+            _f("version", b, &s.version, "u32"),
+            _f("size", b, &s.size, "u32"),
+            _f("lock_pid", b, &s.lock_pid, "i32"),
+            _f("cmd_seq", b, &s.cmd_seq, "u32"),
+            _f("echo_seq", b, &s.echo_seq, "u32"),
+            _f("echo_status", b, &s.echo_status, "i32"),
+            _f("echo_cmd", b, &s.echo_cmd, "i32"),
+            _f("echo_reason", b, &s.echo_reason, "char", MOT_REASON_LEN),
+            _f("command", b, &s.command, "mot_command_t"),
+            _f("status_seq", b, &s.status_seq, "u32"),
+            _f("status", b, &s.status, "mot_status_t"),
+            _f("msg_count", b, &s.msg_count, "u64"),
+            _f("msgs", b, &s.msgs, "mot_msg_t", MOT_MSG_RING),
+            _f("q_head", b, &s.q_head, "u32"),
+            _f("q_tail", b, &s.q_tail, "u32"),
+            _f("q_err_count", b, &s.q_err_count, "u32"),
+            _f("q_err_cmd", b, &s.q_err_cmd, "i32"),
+            _f("q_err_id", b, &s.q_err_id, "i32"),
+            _f("q_err_line", b, &s.q_err_line, "i32"),
+            _f("q_err_reason", b, &s.q_err_reason, "char", MOT_REASON_LEN),
+            _f("queue", b, &s.queue, "mot_command_t", MOT_QUEUE_SIZE),
+        )
+    finally:
+        free(s)
+
+
+LAYOUT = {"PmCartesian": _layout_PmCartesian(),
+          "EmcPose": _layout_EmcPose(),
+          "mot_command_t": _layout_command(),
+          "mot_spindle_status_t": _layout_spindle_status(),
+          "mot_joint_status_t": _layout_joint_status(),
+          "mot_axis_status_t": _layout_axis_status(),
+          "mot_status_t": _layout_status(),
+          "mot_msg_t": _layout_msg(),
+          "mot_channel_t": _layout_channel()}
 
 class ChannelError(Exception):
     """The block is missing, gone, or not a channel of this version."""
@@ -165,11 +670,12 @@ cdef const halsdk_api *_api = NULL
 
 
 cdef const halsdk_api *get_api() except NULL:
+    """The core's C API table, taken as every compiled component takes it
+    (import_halsdk() of halsdk_api.h)."""
     global _api
     if _api == NULL:
-        from halsdk.core import _core
-        _api = <const halsdk_api *>PyCapsule_GetPointer(
-            _core._C_API, b"halsdk.core._core._C_API")
+        import_halsdk()
+        _api = halsdk_api_ptr
         if _api.version < 4:
             _api = NULL
             raise ChannelError("the halsdk core is too old for the motion "
@@ -182,7 +688,7 @@ cdef tuple _pose(EmcPose *p):
 
 
 cdef void _set_pose(EmcPose *p, object v) except *:
-    if len(v) != 9:
+    if len(v) != MOT_MAX_AXES:
         raise ValueError("a pose needs 9 values (X Y Z A B C U V W)")
     p.tran.x, p.tran.y, p.tran.z = v[0], v[1], v[2]
     p.a, p.b, p.c, p.u, p.v, p.w = v[3], v[4], v[5], v[6], v[7], v[8]
@@ -204,7 +710,14 @@ _KNOWN = set(_INT_FIELDS + _FLOAT_FIELDS +
              ("home_flags", "comp", "pos", "center", "normal"))
 
 SIZE = sizeof(mot_channel_t)
+MAGIC = MOT_CHANNEL_MAGIC
+VERSION = MOT_CHANNEL_VERSION
 MAX_JOINTS = MOT_MAX_JOINTS
+MAX_AXES = MOT_MAX_AXES
+MAX_SPINDLES = MOT_MAX_SPINDLES
+MAX_AIO = MOT_MAX_AIO
+REASON_LEN = MOT_REASON_LEN
+MSG_LEN = MOT_MSG_LEN
 MSG_RING = MOT_MSG_RING
 QUEUE_SIZE = MOT_QUEUE_SIZE
 
@@ -248,8 +761,11 @@ cdef class Channel:
 
     def __init__(self, str name, int pid):
         cdef const halsdk_api *api = get_api()
-        from halsdk.core import _core
-        addr, size = _core.shmem_attach(name)    # NotFoundError if none
+        hal = Hal.current()
+        if hal is None:
+            raise InstanceError(f"motion channel '{name}': this process is "
+                                "not attached to a HAL instance")
+        addr, size = hal.shared_block(name)     # NotFoundError if none
         cdef bytes b = name.encode()
         self.handle = api.shmem_attach(b)
         if self.handle < 0:
@@ -340,9 +856,9 @@ cdef class Channel:
         cdef uint32_t seq = mch_load32(&c.echo_seq)
         cdef int32_t st = c.echo_status
         cdef int32_t code = c.echo_cmd
-        cdef char reason[200]
-        memcpy(reason, c.echo_reason, 200)
-        reason[199] = 0
+        cdef char reason[MOT_REASON_LEN]
+        memcpy(reason, c.echo_reason, MOT_REASON_LEN)
+        reason[MOT_REASON_LEN - 1] = 0
         return seq, st, code, reason.decode("utf-8", "replace")
 
     # ---------------------------------------------------------- queue
@@ -388,9 +904,9 @@ cdef class Channel:
         queued record."""
         cdef mot_channel_t *c = self.live()
         cdef uint32_t n = mch_load32(&c.q_err_count)
-        cdef char reason[200]
-        memcpy(reason, c.q_err_reason, 200)
-        reason[199] = 0
+        cdef char reason[MOT_REASON_LEN]
+        memcpy(reason, c.q_err_reason, MOT_REASON_LEN)
+        reason[MOT_REASON_LEN - 1] = 0
         return (n, c.q_err_cmd, c.q_err_id, c.q_err_line,
                 reason.decode("utf-8", "replace"))
 
@@ -456,7 +972,7 @@ cdef class Channel:
                 lost += 1
                 r += 1
                 continue
-            m.text[199] = 0
+            m.text[MOT_MSG_LEN - 1] = 0
             out.append(m.text.decode("utf-8", "replace"))
             r += 1
         return out, r, lost

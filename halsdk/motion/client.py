@@ -23,22 +23,29 @@ import time
 from collections.abc import Iterable, Mapping, Sequence
 from typing import Any, Callable, Optional, Union
 
-from halsdk.core import _core
 from halsdk.errors import HalError, NotFoundError
-from halsdk.motion import _channel
-from halsdk.motion.status import (
-    AXES,
-    JOINT_HOMED,
+from halsdk.hal import Hal
+from halsdk.motion import _channel, screwcomp
+from halsdk.motion.ini import (
+    axis_plan,
+    homing_fields,
+    joint_plan,
+    read_motion_ini,
+    traj_plan,
+)
+from halsdk.motion.protocol import (
+    Cmd,
+    Echo,
     Mode,
     MotionType,
-    Pose,
+    ProbeFlag,
     Profile,
-    Status,
     TermCond,
 )
+from halsdk.motion.status import AXES, JOINT_HOMED, Pose, Status
 
 __all__ = ["Motion", "Rejected", "QueueRejected", "MotionError",
-           "MotionTimeout", "Cmd", "InputWait"]
+           "MotionTimeout", "Cmd", "Echo", "InputWait", "homing_fields"]
 
 CHANNEL_NAME = "motmod.channel"
 
@@ -99,97 +106,6 @@ LINEAR_UNITS = {"mm": 1.0, "metric": 1.0, "cm": 10.0, "inch": 25.4,
                 "in": 25.4, "imperial": 25.4}
 
 
-class Cmd(enum.IntEnum):
-    """Command codes of channel.h (part of the protocol)."""
-    ABORT = 1
-    FREE = 2
-    TELEOP = 3
-    COORD = 4
-    ENABLE = 5
-    DISABLE = 6
-    ENABLE_AMPLIFIER = 7
-    DISABLE_AMPLIFIER = 8
-    ACTIVATE_JOINT = 9
-    DEACTIVATE_JOINT = 10
-    PAUSE = 11
-    RESUME = 12
-    STEP = 13
-    SCALE = 14
-    RAPID_SCALE = 15
-    OVERRIDE_LIMITS = 16
-    HOME = 20
-    UNHOME = 21
-    JOG_CONT = 30
-    JOG_INCR = 31
-    JOG_ABS = 32
-    JOG_STOP = 33
-    SET_LINE = 40
-    SET_CIRCLE = 41
-    SET_TELEOP_VECTOR = 42
-    PROBE = 43
-    CLEAR_PROBE_FLAG = 44
-    SET_NUM_JOINTS = 50
-    SET_JOINT_POSITION_LIMITS = 51
-    SET_JOINT_VEL_LIMIT = 52
-    SET_JOINT_ACC_LIMIT = 53
-    SET_JOINT_JERK_LIMIT = 54
-    SET_JOINT_MIN_FERROR = 55
-    SET_JOINT_MAX_FERROR = 56
-    SET_JOINT_HOMING_PARAMS = 57
-    SET_JOINT_BACKLASH = 58
-    SET_JOINT_COMP = 59
-    CLEAR_JOINT_COMP = 60
-    SET_JOINT_MOTOR_OFFSET = 61
-    SET_AXIS_POSITION_LIMITS = 62
-    SET_AXIS_VEL_LIMIT = 63
-    SET_AXIS_ACC_LIMIT = 64
-    SET_AXIS_JERK_LIMIT = 65
-    SET_VEL = 66
-    SET_VEL_LIMIT = 67
-    SET_ACC = 68
-    SET_TERM_COND = 69
-    SET_OFFSET = 70
-    SET_PROFILE = 71
-    SET_DOUT = 72
-    SET_AOUT = 73
-    SET_FEED_HOLD_ENABLE = 100
-    SET_ADAPTIVE_FEED_ENABLE = 101
-    SET_LINEAR_UNITS = 102
-    SPINDLE_ON = 110
-    SPINDLE_OFF = 111
-    SPINDLE_INCREASE = 112
-    SPINDLE_DECREASE = 113
-    SPINDLE_ORIENT = 114
-    SPINDLE_BRAKE_ENGAGE = 115
-    SPINDLE_BRAKE_RELEASE = 116
-    SPINDLE_SYNC_LINE = 120
-    RIGID_TAP = 121
-
-
-class Echo(enum.IntEnum):
-    NONE = 0
-    DONE = 1            #: carried out completely
-    ACCEPTED = 2        #: started; goes on in later cycles
-    REJECTED = 3
-
-
-# homing flags (homing.h)
-HOME_IGNORE_LIMITS = 0x0001
-HOME_USE_INDEX = 0x0002
-HOME_IS_SHARED = 0x0004
-HOME_UNLOCK_FIRST = 0x0008
-HOME_ABSOLUTE_ENCODER = 0x0010
-HOME_NO_REHOME = 0x0020
-HOME_NO_FINAL_MOVE = 0x0040
-HOME_INDEX_NO_ENCODER_RESET = 0x0080
-
-# home_sequence when HOME_SEQUENCE is not set (homing.h)
-HOME_SEQUENCE_NONE = -1000
-
-# probe type bits
-PROBE_NO_ERROR = 0x1
-PROBE_AWAY = 0x2
-
 # one sender at a time in this process (the channel lock is per process)
 _send_lock = threading.RLock()
 
@@ -248,9 +164,8 @@ class Motion:
             another version or size.
         """
         own = None
-        if hal is None and not _core.attached():
-            import halsdk
-            own = halsdk.Hal(create=False)
+        if hal is None and not _attached():
+            own = Hal(create=False)
         try:
             ch = _channel.Channel(name, os.getpid())
         except NotFoundError:
@@ -284,7 +199,7 @@ class Motion:
         """True when waits step the servo thread themselves (the client
         has the Hal and its threads do not run in real time)."""
         return (self._hal is not None and
-                not _core.info()["threads_running"])
+                not self._hal.info()["threads_running"])
 
     def moves_done(self, status: Optional[Status] = None) -> bool:
         """Every queued move was taken and has run, and nothing moves
@@ -565,9 +480,9 @@ class Motion:
         error.  Returns the motion id."""
         p = self._pose(end, "PROBE end")
         f = self._move_fields(vel, ini_maxvel, acc, id)
-        ptype = (PROBE_AWAY if away else 0) | \
-            (0 if error_if_no_contact else PROBE_NO_ERROR)
-        self.command(Cmd.PROBE, pos=p, ival=ptype, line=line,
+        ptype = (ProbeFlag.AWAY if away else 0) | \
+            (0 if error_if_no_contact else ProbeFlag.NO_ERROR)
+        self.command(Cmd.PROBE, pos=p, ival=int(ptype), line=line,
                      motion_type=int(MotionType.PROBING), **f)
         self._last_end = Pose(*p)
         return f["id"]
@@ -673,9 +588,9 @@ class Motion:
         """Like :meth:`probe`, through the move queue."""
         p = self._pose(end, "PROBE end")
         f = self._move_fields(vel, ini_maxvel, acc, id)
-        ptype = (PROBE_AWAY if away else 0) | \
-            (0 if error_if_no_contact else PROBE_NO_ERROR)
-        self.queue(Cmd.PROBE, pos=p, ival=ptype, line=line,
+        ptype = (ProbeFlag.AWAY if away else 0) | \
+            (0 if error_if_no_contact else ProbeFlag.NO_ERROR)
+        self.queue(Cmd.PROBE, pos=p, ival=int(ptype), line=line,
                    motion_type=int(MotionType.PROBING), **f)
         self._last_end = Pose(*p)
         return f["id"]
@@ -816,9 +731,6 @@ class Motion:
         self.command(Cmd.SET_JOINT_HOMING_PARAMS, joint=joint,
                      **homing_fields(keys, f"joint {joint}"))
 
-    def _homing_plan(self, joint: int, keys: Mapping[str, Any]) -> None:
-        self.set_joint_homing(joint, **keys)
-
     def clear_joint_comp(self, joint: int) -> None:
         self.command(Cmd.CLEAR_JOINT_COMP, joint=joint)
 
@@ -840,7 +752,7 @@ class Motion:
         """Read a compensation file (COMP_FILE, COMP_FILE_TYPE of
         [JOINT_n]) and send it; returns the number of entries.  A bad
         file raises before anything is sent, naming the line."""
-        entries = read_comp_file(path, type)
+        entries = screwcomp.read_comp_file(path, type)
         self.set_joint_comp(joint, entries)
         return len(entries)
 
@@ -1034,27 +946,22 @@ class Motion:
         DEFAULT_LINEAR_VELOCITY, MAX_LINEAR_ACCELERATION or
         MAX_ACCELERATION).  Unknown keys raise ValueError before anything
         is sent."""
-        plans = [(j, _joint_plan(j, keys)) for j, keys in enumerate(joints)]
-        axis_plans = [(_axis(k), _axis_plan(k, v))
-                      for k, v in (axes or {}).items()]
-        traj_plan = _traj_plan(traj or {})
+        plans = [((j,), joint_plan(j, keys))
+                 for j, keys in enumerate(joints)]
+        plans += [((_axis(k),), axis_plan(k, v))
+                  for k, v in (axes or {}).items()]
+        plans.append(((), traj_plan(traj or {})))
         if joints:
             self.set_num_joints(len(joints))
-        for j, plan in plans:
-            for fn, args in plan:
-                getattr(self, fn)(j, *args)
-        for a, plan in axis_plans:
-            for fn, args in plan:
-                getattr(self, fn)(a, *args)
-        for fn, args in traj_plan:
-            getattr(self, fn)(*args)
+        for first, plan in plans:
+            for fn, args, kwargs in plan:
+                getattr(self, fn)(*first, *args, **kwargs)
 
     def configure_ini(self, path: str) -> None:
         """Send the motion configuration of an INI file: [KINS]JOINTS,
         [JOINT_n], [AXIS_L] and [TRAJ] (see :mod:`halsdk.motion.ini`).
         The whole file is checked first: a bad value raises
         MotionIniError naming the file and line, and nothing is sent."""
-        from halsdk.motion.ini import read_motion_ini
         config = read_motion_ini(path)
         self.configure(config.joints, config.axes, config.traj)
 
@@ -1249,179 +1156,6 @@ def _axis(axis: JointOrAxis) -> int:
     return _axis_index(axis) if isinstance(axis, str) else int(axis)
 
 
-# ---------------------------------------------------------------- INI keys
-
-_HOME_FLOATS = {"home": "home", "home_offset": "home_offset",
-                "home_search_vel": "home_search_vel",
-                "home_latch_vel": "home_latch_vel",
-                "home_final_vel": "home_final_vel"}
-_HOME_BOOLS = {"home_use_index": HOME_USE_INDEX,
-               "home_ignore_limits": HOME_IGNORE_LIMITS,
-               "home_is_shared": HOME_IS_SHARED,
-               "home_unlock_first": HOME_UNLOCK_FIRST,
-               "home_no_rehome": HOME_NO_REHOME,
-               "home_no_final_move": HOME_NO_FINAL_MOVE,
-               "home_index_no_encoder_reset": HOME_INDEX_NO_ENCODER_RESET}
-HOMING_KEYS = (set(_HOME_FLOATS) | set(_HOME_BOOLS) |
-               {"home_sequence", "volatile_home", "home_absolute_encoder"})
-
-
-def _ini_bool(v: Any, key: str) -> bool:
-    if isinstance(v, str):
-        s = v.strip().lower()
-        if s in ("1", "yes", "true", "on"):
-            return True
-        if s in ("0", "no", "false", "off", ""):
-            return False
-        raise ValueError(f"{key} = {v!r} is not a yes/no value")
-    return bool(v)
-
-
-def homing_fields(keys: Mapping[str, Any], where: str = "") -> dict:
-    """[JOINT_n] homing keys -> fields of SET_JOINT_HOMING_PARAMS (the
-    values of an unset key are the reference's defaults; no
-    HOME_SEQUENCE: the joint is not part of "home all")."""
-    out = {"home": 0.0, "home_offset": 0.0, "home_search_vel": 0.0,
-           "home_latch_vel": 0.0, "home_final_vel": -1.0,
-           "home_sequence": HOME_SEQUENCE_NONE, "volatile_home": 0,
-           "home_flags": 0}
-    flags = 0
-    pre = f"{where}: " if where else ""
-
-    def conv(fn, k, v):
-        try:
-            return fn(v)
-        except (TypeError, ValueError):
-            raise ValueError(f"{pre}{k.upper()} = {v!r} is not "
-                             f"{'a number' if fn is float else 'an integer'}"
-                             ) from None
-
-    for k, v in keys.items():
-        key = k.lower()
-        if key in _HOME_FLOATS:
-            out[_HOME_FLOATS[key]] = conv(float, k, v)
-        elif key in _HOME_BOOLS:
-            if _ini_bool(v, pre + key):
-                flags |= _HOME_BOOLS[key]
-        elif key == "home_sequence":
-            out["home_sequence"] = conv(int, k, v)
-        elif key == "volatile_home":
-            out["volatile_home"] = 1 if _ini_bool(v, pre + key) else 0
-        elif key == "home_absolute_encoder":
-            n = conv(int, k, v)
-            if n not in (0, 1, 2):
-                raise ValueError(f"{pre}HOME_ABSOLUTE_ENCODER = {v!r} must "
-                                 "be 0, 1 or 2")
-            if n:
-                flags |= HOME_ABSOLUTE_ENCODER
-            if n == 2:
-                flags |= HOME_NO_FINAL_MOVE
-        else:
-            raise ValueError(f"{pre}unknown homing key {k.upper()}")
-    out["home_flags"] = flags
-    return out
-
-
-def read_comp_file(path: str, type: int = 0) -> list:
-    """Entries (nominal, forward trim, reverse trim) of a compensation file
-    of COMP_FILE_TYPE ``type`` (halsdk.motion.compfile; a malformed file
-    raises CompFileError naming the line)."""
-    from halsdk.motion import compfile
-    return [tuple(e) for e in compfile.read_comp_file(path, type)]
-
-
-def _num(keys: Mapping[str, Any], key: str, where: str) -> float:
-    v = keys[key]
-    try:
-        return float(v)
-    except (TypeError, ValueError):
-        raise ValueError(f"{where}: {key.upper()} = {v!r} is not a "
-                         "number") from None
-
-
-def _lower(keys: Mapping[str, Any]) -> dict:
-    return {k.lower(): v for k, v in keys.items()}
-
-
-def _limits_plan(kind: str, k: Mapping[str, Any], where: str) -> list:
-    """Soft limits, velocity, acceleration and jerk of a joint or axis
-    (kind): the calls that send the keys present."""
-    plan = []
-    if "min_limit" in k or "max_limit" in k:
-        lo = _num(k, "min_limit", where) if "min_limit" in k else -1e99
-        hi = _num(k, "max_limit", where) if "max_limit" in k else 1e99
-        plan.append((f"set_{kind}_limits", (lo, hi)))
-    for key in ("max_velocity", "max_acceleration", "max_jerk"):
-        if key in k:
-            plan.append((f"set_{kind}_{key}", (_num(k, key, where),)))
-    return plan
-
-
-def _joint_plan(j: int, keys: Mapping[str, Any]) -> list:
-    where = f"[JOINT_{j}]"
-    k = _lower(keys)
-    known = {"min_limit", "max_limit", "max_velocity", "max_acceleration",
-             "max_jerk", "ferror", "min_ferror", "backlash", "comp_file",
-             "comp_file_type", "type"} | HOMING_KEYS
-    bad = sorted(set(k) - known)
-    if bad:
-        raise ValueError(f"{where}: unknown key(s) "
-                         f"{', '.join(b.upper() for b in bad)}")
-    plan = _limits_plan("joint", k, where)
-    if "ferror" in k or "min_ferror" in k:
-        fe = _num(k, "ferror", where) if "ferror" in k else 1.0
-        mfe = _num(k, "min_ferror", where) if "min_ferror" in k else fe
-        plan.append(("set_joint_ferror", (mfe, fe)))
-    if "backlash" in k:
-        plan.append(("set_joint_backlash", (_num(k, "backlash", where),)))
-    homing = {key: v for key, v in k.items() if key in HOMING_KEYS}
-    if homing:
-        homing_fields(homing, where)        # check before sending
-        plan.append(("_homing_plan", (homing,)))
-    if "comp_file" in k:
-        ctype = k.get("comp_file_type", 0)
-        try:
-            ctype = int(ctype)
-        except (TypeError, ValueError):
-            raise ValueError(f"{where}: COMP_FILE_TYPE = {ctype!r} is not "
-                             "0 or 1") from None
-        entries = read_comp_file(str(k["comp_file"]), ctype)
-        plan.append(("set_joint_comp", (entries,)))
-    return plan
-
-
-def _axis_plan(letter: Any, keys: Mapping[str, Any]) -> list:
-    where = f"[AXIS_{str(letter).upper()}]"
-    k = _lower(keys)
-    known = {"min_limit", "max_limit", "max_velocity", "max_acceleration",
-             "max_jerk"}
-    bad = sorted(set(k) - known)
-    if bad:
-        raise ValueError(f"{where}: unknown key(s) "
-                         f"{', '.join(b.upper() for b in bad)}")
-    return _limits_plan("axis", k, where)
-
-
-def _traj_plan(keys: Mapping[str, Any]) -> list:
-    where = "[TRAJ]"
-    k = _lower(keys)
-    known = {"max_linear_velocity", "max_velocity",
-             "default_linear_velocity", "default_velocity",
-             "max_linear_acceleration", "max_acceleration",
-             "default_linear_acceleration", "default_acceleration"}
-    bad = sorted(set(k) - known)
-    if bad:
-        raise ValueError(f"{where}: unknown key(s) "
-                         f"{', '.join(b.upper() for b in bad)}")
-    plan = []
-    for key in ("max_linear_velocity", "max_velocity"):
-        if key in k:
-            plan.append(("set_vel_limit", (_num(k, key, where),)))
-    for key in ("default_linear_velocity", "default_velocity"):
-        if key in k:
-            plan.append(("set_vel", (_num(k, key, where),)))
-    for key in ("max_linear_acceleration", "max_acceleration",
-                "default_linear_acceleration", "default_acceleration"):
-        if key in k:
-            plan.append(("set_acc", (_num(k, key, where),)))
-    return plan
+def _attached() -> bool:
+    """This process is attached to a HAL instance already."""
+    return Hal.current() is not None

@@ -6,50 +6,24 @@ consistent copy of what motmod published at the end of one servo cycle.
 
 from __future__ import annotations
 
-import enum
 from dataclasses import dataclass
 from typing import NamedTuple
 
+from halsdk.motion.protocol import (
+    JointFlag,
+    KinsType,
+    Mode,
+    MotionType,
+    OrientState,
+    Profile,
+    TermCond,
+)
+
+__all__ = ["Status", "JointStatus", "AxisStatus", "SpindleStatus", "Pose",
+           "Mode", "KinsType", "MotionType", "OrientState", "Profile",
+           "TermCond", "AXES"]
+
 AXES = "xyzabcuvw"
-
-
-class Mode(enum.IntEnum):
-    """Operating mode of the motion controller."""
-    FREE = 0        #: joints move on their own (jogs, homing)
-    TELEOP = 1      #: Cartesian velocity / axis jogs through kinematics
-    COORD = 2       #: the trajectory planner runs queued moves
-
-
-class KinsType(enum.IntEnum):
-    """kinematicsType() of the loaded kinematics module."""
-    IDENTITY = 1
-    FORWARD_ONLY = 2
-    INVERSE_ONLY = 3
-    BOTH = 4
-
-
-class MotionType(enum.IntEnum):
-    """Kind of a coordinated move (also on ``motion.motion-type``)."""
-    NONE = 0
-    TRAVERSE = 1
-    FEED = 2
-    ARC = 3
-    TOOLCHANGE = 4
-    PROBING = 5
-    INDEXROTARY = 6
-
-
-class Profile(enum.IntEnum):
-    """Profile of the free and teleop planners."""
-    TRAPEZOID = 0
-    JERK = 1
-
-
-class TermCond(enum.IntEnum):
-    """What the planner does at the end of a coordinated move."""
-    STOP = 0        #: exact stop (G61.1)
-    EXACT = 1       #: exact path (G61)
-    BLEND = 2       #: blend within a tolerance (G64 P)
 
 
 class Pose(NamedTuple):
@@ -66,18 +40,18 @@ class Pose(NamedTuple):
 
 
 # bits of the joint flags (mot_joint.h)
-JOINT_ACTIVE = 0x0001
-JOINT_ENABLED = 0x0002
-JOINT_INPOS = 0x0004
-JOINT_ERROR = 0x0008
-JOINT_POS_SOFT = 0x0010
-JOINT_NEG_SOFT = 0x0020
-JOINT_POS_HARD = 0x0040
-JOINT_NEG_HARD = 0x0080
-JOINT_FERROR = 0x0100
-JOINT_FAULT = 0x0200
-JOINT_HOMING = 0x0400
-JOINT_HOMED = 0x0800
+JOINT_ACTIVE = int(JointFlag.ACTIVE)
+JOINT_ENABLED = int(JointFlag.ENABLED)
+JOINT_INPOS = int(JointFlag.INPOS)
+JOINT_ERROR = int(JointFlag.ERROR)
+JOINT_POS_SOFT = int(JointFlag.POS_SOFT)
+JOINT_NEG_SOFT = int(JointFlag.NEG_SOFT)
+JOINT_POS_HARD = int(JointFlag.POS_HARD)
+JOINT_NEG_HARD = int(JointFlag.NEG_HARD)
+JOINT_FERROR = int(JointFlag.FERROR)
+JOINT_FAULT = int(JointFlag.FAULT)
+JOINT_HOMING = int(JointFlag.HOMING)
+JOINT_HOMED = int(JointFlag.HOMED)
 
 
 @dataclass(frozen=True)
@@ -178,14 +152,6 @@ class AxisStatus:
                    max_pos_limit=d["max_pos_limit"],
                    vel_limit=d["vel_limit"], acc_limit=d["acc_limit"],
                    jerk_limit=d["jerk_limit"])
-
-
-class OrientState(enum.IntEnum):
-    """Where a spindle's orient (M19) is."""
-    NONE = 0
-    RUNNING = 1     #: spindle.N.orient is true, waiting for is-oriented
-    DONE = 2        #: oriented: locked and braked
-    FAULT = 3       #: spindle.N.orient-fault was not 0
 
 
 @dataclass(frozen=True)

@@ -1,4 +1,4 @@
-"""Reading a joint's compensation file ([JOINT_n]COMP_FILE).
+"""Reading a joint's lead-screw compensation file ([JOINT_n]COMP_FILE).
 
 The file holds one entry per line: three numbers separated by blanks, the
 nominal (commanded) position first.  What the other two mean depends on
