@@ -1,6 +1,6 @@
 """Run part programs on a simulated machine and check the traces.
 
-Shared by tests/test_motion_programs.py and bench/tp.py (the example
+Shared by tests/motion/test_part_programs.py and bench/tp.py (the example
 examples/contour/ carries its own small copy, so that it stands alone).
 
 * :class:`Line`, :class:`Arc`, :class:`PathMode`, :class:`Probe`: the
