@@ -1,145 +1,23 @@
 """Tests of the HAL language executor and the halcmd/halrun programs.
 
-The differential tests run every ``tests/halfiles/NAME.hal`` with our
-``halrun -f`` and compare with ``NAME.out``, the output of the reference
-``halrun -f NAME.hal`` (stdout and stderr together) after
-:func:`normalize`, which removes what cannot match:
-
-1. the reference's ``Note: Using POSIX non-realtime`` lines (printed by
-   its realtime start/stop scripts, at a timing-dependent place);
-2. the pid in the name and PID column of the ``halcmd<pid>`` component;
-3. component ids (``show comp`` ID column, pin/param/funct Owner
-   column): the reference's ids have gaps from its helper processes;
-4. function code and argument addresses (``show funct``, also in the
-   ``-s`` format).
-
-``NAME.rc`` holds the reference's exit status; only zero/non-zero is
-compared (the reference halrun's codes come from its shell script).
-
-To make a golden: copy ``NAME.hal`` and its companions (``NAME.ini``,
-``NAME.inc``) to an empty folder and there run
-``HALTEST_WORD=bar .../reference halrun OPTIONS -f NAME.hal > NAME.out 2>&1``
-where OPTIONS are those of the file's first line ``# options: ...``;
-write the exit status to ``NAME.rc``.
+The differential corpus (``tests/data/halfiles``, the reference's
+recorded outputs) is run by ``tests/golden/test_halcmd_golden.py``.
 """
 
 from __future__ import annotations
 
 import os
-import re
 import subprocess
 import sys
-from pathlib import Path
 
 import pytest
 
 from halsdk import _core, halcmd
 from halsdk.halcmd import Executor, logical_lines, parse_value, tokenize
 from halsdk.halcmd.lexer import IniFile, SubstitutionError
-
-NOTE = "Note: Using POSIX non-realtime"
-HALFILES = Path(__file__).parent / "halfiles"
-
-_COMP_ROW = re.compile(r"^ [ \d]{4}\d  (RT  |User)  ")
-_ITEM_ROW = re.compile(r"^ [ \d]{4}\d(  (bit  |float|s32  |u32  |s64  |u64  )"
-                       r" (IN |OUT|I/O|RO |RW )  )")
-_FUNCT_ROW = re.compile(r"^ \d{5}  [0-9a-f ]{12}  [0-9a-f ]{12}  ")
-_SCRIPT_FUNCT_ROW = re.compile(r"^(\S+) [0-9a-f]+ [0-9a-f]+ (YES|NO) ")
-
-
-def normalize(text: str) -> str:
-    """Remove what cannot match between the reference and halsdk."""
-    out = []
-    for line in text.splitlines(True):
-        if line.rstrip("\n") == NOTE:
-            continue
-        if _COMP_ROW.match(line) and len(line) > 67:
-            name = re.sub(r"^halcmd\d+", "halcmd<PID>", line[14:61].strip())
-            pid = "  PID" if line[8:12] == "User" else line[62:67]
-            line = ("    ID" + line[6:14] + f"{name:<47}" + line[61]
-                    + pid + line[67:])
-            out.append(line)
-            continue
-        line = re.sub(r"halcmd\d+", "halcmd<PID>", line)
-        if _ITEM_ROW.match(line):
-            line = "    ID" + line[6:]
-        elif _FUNCT_ROW.match(line):
-            line = " IDIDI  <code-addr>   <arg-addr>    " + line[36:]
-        else:
-            line = _SCRIPT_FUNCT_ROW.sub(r"\1 <code-addr> <arg-addr> \2 ",
-                                         line)
-        out.append(line)
-    return "".join(out)
-
-
-# ---------------------------------------------------------------- helpers
-
-def _options(hal_file: Path) -> list[str]:
-    """Options from a first line ``# options: -k ...`` of a HAL file."""
-    first = hal_file.read_text().splitlines()[:1]
-    if first and first[0].startswith("# options:"):
-        return first[0].split(":", 1)[1].split()
-    return []
-
-
-def _env(tmp_path: Path, name: str) -> dict:
-    env = dict(os.environ)
-    env["HALSDK_INSTANCE"] = f"t3-{os.getpid()}-{name}"
-    env["HALTEST_WORD"] = "bar"
-    env.pop("HALTEST_NOPE", None)
-    return env
-
-
-def _cli(args: list[str], cwd: Path, env: dict,
-         stdin: str = "") -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "halsdk.halcmd.cli", *args], cwd=cwd,
-        env=env, input=stdin, stdout=subprocess.PIPE,
-        stderr=subprocess.STDOUT, text=True, timeout=60)
-
-
-def _shm_left(env: dict) -> list[str]:
-    tag = env["HALSDK_INSTANCE"]
-    return [n for n in os.listdir("/dev/shm") if tag in n]
-
-
-# ---------------------------------------------------------------- goldens
-
-GOLDENS = sorted(p for p in HALFILES.glob("*.hal")
-                 if p.with_suffix(".out").exists())
-
-
-def test_corpus_is_there():
-    assert len(GOLDENS) >= 20
-
-
-@pytest.mark.parametrize("hal_file", GOLDENS, ids=lambda p: p.stem)
-def test_golden(hal_file: Path, tmp_path: Path):
-    """Our halrun prints what the reference printed (normalized)."""
-    for extra in HALFILES.glob(hal_file.stem + ".*"):
-        if extra.suffix not in (".out", ".rc"):
-            (tmp_path / extra.name).write_bytes(extra.read_bytes())
-    env = _env(tmp_path, hal_file.stem)
-    proc = _cli(["halrun", *_options(hal_file), "-f", hal_file.name],
-                tmp_path, env)
-    expected = normalize(hal_file.with_suffix(".out").read_text())
-    assert normalize(proc.stdout) == expected
-    ref_rc = int(hal_file.with_suffix(".rc").read_text())
-    assert (proc.returncode == 0) == (ref_rc == 0), proc.stdout
-    assert _shm_left(env) == []
-
-
-def test_normalize_keeps_widths_and_drops_notes():
-    text = (NOTE + "\n"
-            "     7  User  halcmd4395" + " " * 37 + "  4395 ready\n"
-            "     8  bit   IN           TRUE  and2.0.in0\n"
-            " 00008  7fa520eee189  7fa52003d140  NO       0   and2.0\n")
-    out = normalize(text).splitlines()
-    assert out[0] == "    ID  User  halcmd<PID>" + " " * 36 + "   PID ready"
-    assert out[1] == "    ID  bit   IN           TRUE  and2.0.in0"
-    assert out[2].endswith("  NO       0   and2.0")
-    assert "7fa5" not in out[2]
-
+from helpers.halrun import halcmd_env as _env
+from helpers.halrun import run_cli as _cli
+from helpers.halrun import shm_left as _shm_left
 
 # ---------------------------------------------------------------- lexer
 

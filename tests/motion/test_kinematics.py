@@ -1,12 +1,12 @@
 """Kinematics modules: trivkins, corexykins, scarakins, lineardeltakins.
 
-The load listings are compared with the reference's (tests/motion/kins-*).
-The transforms are C functions that each module exports
-(kinematicsForward, kinematicsInverse, ...); the tests call them through
-ctypes at the addresses halsdk._core.symbol_address() gives: round trips
-over each workspace, known points (some with the reference's numbers),
-and points without a solution, which must give a non-zero return and
-leave the output untouched (so no NaN ever comes out).
+The load listings are compared with the reference's in
+tests/golden/test_kins_listings.py.  The transforms are C functions that
+each module exports (kinematicsForward, kinematicsInverse, ...); the tests
+call them through ctypes at the addresses halsdk._core.symbol_address()
+gives: round trips over each workspace, known points (some with the
+reference's numbers), and points without a solution, which must give a
+non-zero return and leave the output untouched (so no NaN ever comes out).
 """
 
 from __future__ import annotations
@@ -17,13 +17,13 @@ import random
 from pathlib import Path
 
 import pytest
-from conftest import on_halsdk_path
-from test_halcmd import _cli, _env, _shm_left, normalize
 
 import halsdk
 from halsdk import _core
+from helpers import data_path, repo_path
+from helpers.environment import on_halsdk_path
 
-MOTION = Path(__file__).parent / "motion"
+MOTION = data_path("motion")
 AXES = "x y z a b c u v w".split()
 MAX_JOINTS = 16
 UNTOUCHED = 1234.5          # what the tests put in outputs beforehand
@@ -97,46 +97,6 @@ def load(hal, name: str, *args: str) -> Kins:
 def close(a, b, rel=1e-9) -> bool:
     return all(abs(x - y) <= rel * max(1.0, abs(x), abs(y))
                for x, y in zip(a, b))
-
-
-# ------------------------------------------------------------ load listings
-
-def _tables(text: str) -> list[str]:
-    """The show tables of a halrun output, without the module's chatter."""
-    keep = ("Loaded HAL Components:", "ID      Type", "Component Pins:",
-            "Owner   ", "Parameters:", "Exported Functions:")
-    return [line for line in normalize(text).splitlines()
-            if line.startswith(keep) or line.startswith("    ID")
-            or line.startswith(" IDIDI")]
-
-
-GOLDENS = sorted(MOTION.glob("kins-*.hal"))
-# our reason for each load the reference refuses too
-REASONS = {
-    "kins-trivkins-bad-letter": "'q' (joint 3) is not an axis letter",
-    "kins-trivkins-empty": "coordinates= is empty",
-    "kins-trivkins-unknown-param": "Unknown parameter `foo=1'",
-    "kins-corexykins-coordinates": "Unknown parameter `coordinates=xyz'",
-}
-
-
-def test_golden_corpus_is_there():
-    assert len(GOLDENS) >= 9
-    assert set(REASONS) < {p.stem for p in GOLDENS}
-
-
-@pytest.mark.parametrize("hal_file", GOLDENS, ids=lambda p: p.stem)
-def test_load_listing_matches_reference(hal_file: Path, tmp_path: Path):
-    (tmp_path / hal_file.name).write_bytes(hal_file.read_bytes())
-    env = _env(tmp_path, hal_file.stem)
-    proc = _cli(["halrun", "-f", hal_file.name], tmp_path, env)
-    ref = hal_file.with_suffix(".out").read_text()
-    ref_ok = int(hal_file.with_suffix(".rc").read_text()) == 0
-    assert (proc.returncode == 0) == ref_ok, proc.stdout
-    assert _tables(proc.stdout) == _tables(ref)
-    if not ref_ok:
-        assert REASONS[hal_file.stem] in proc.stdout
-    assert _shm_left(env) == []
 
 
 def test_only_one_kinematics_module_at_a_time(hal):
@@ -480,7 +440,7 @@ def test_lineardeltakins_bad_geometry_fails_cleanly(hal):
 
 # ------------------------------------- the examples of docs/kinematics.rst
 
-DOC = Path(__file__).parents[1] / "docs" / "kinematics.rst"
+DOC = repo_path("docs", "kinematics.rst")
 
 
 def _doc_block(caption_or_lang: str) -> str:
@@ -502,7 +462,7 @@ def _doc_block(caption_or_lang: str) -> str:
 
 @pytest.fixture
 def skewkins_dir(tmp_path: Path):
-    from test_halcompile import halcompile
+    from helpers.halcompile import halcompile
     (tmp_path / "skewkins.c").write_text(_doc_block("skewkins.c"))
     # kinematics.h and emcpose.h are installed headers: no -I needed
     proc = halcompile("--compile", "--extra-compile-args",

@@ -1,11 +1,10 @@
 """The motion module motmod: loading, command channel, modes, jogs, limits.
 
-Load listings are compared with the reference's (tests/motion/motmod-*:
-`show pin/param/funct/thread` after loading trivkins, homemod, tpmod and
-motmod).  Commands go through the shared block "motmod.channel" with a
-small ctypes mirror of components/motion/channel.h written here, so these
-tests depend on no client library; each command is echoed after one servo
-cycle (the handler runs first in the servo thread).
+Load listings are compared with the reference's in
+tests/golden/test_motmod_listings.py.  Commands go through the shared block
+"motmod.channel" with a small ctypes mirror of components/motion/channel.h
+written here, so these tests depend on no client library; each command is
+echoed after one servo cycle (the handler runs first in the servo thread).
 """
 
 from __future__ import annotations
@@ -13,16 +12,15 @@ from __future__ import annotations
 import ctypes as C
 import math
 import re
-from pathlib import Path
 
 import numpy as np
 import pytest
-from test_halcmd import _cli, _env, _shm_left, normalize
 
 import halsdk
 from halsdk import _core
+from helpers import data_path
 
-MOTION = Path(__file__).parent / "motion"
+MOTION = data_path("motion")
 DT = 0.001                      # servo period of the tests (s)
 
 # --------------------------------------------------------- channel mirror
@@ -270,66 +268,6 @@ def check_limits(trace, name_v, vmax, amax, tol=1e-6):
     assert np.abs(v).max() <= vmax * (1 + tol)
     acc = np.diff(v) / DT
     assert np.abs(acc).max() <= amax * (1 + tol) + 1e-9
-
-
-# ------------------------------------------------------------ load listings
-
-def _tables(text: str) -> list[str]:
-    """The show tables without component lines, addresses and owner ids."""
-    out = []
-    for line in normalize(text).splitlines():
-        f = line.split()
-        if not f or line.startswith("Note:") or "servo-thread.t" in line \
-                or "base-thread.t" in line:
-            continue
-        if re.match(r"^    ID  (bit|float|s32|u32)", line):
-            out.append(" ".join(f[1:]))
-        elif len(f) >= 4 and f[-3] in ("YES", "NO") and f[-2].isdigit():
-            out.append(" ".join(f[-3:]))          # a function row
-        elif re.match(r"^ +\d+ +(YES|NO) ", line):
-            out.append(" ".join(f[:3]))
-        elif line.endswith(":"):
-            out.append(line)
-    return out
-
-
-@pytest.mark.parametrize("case", ["motmod-3joints", "motmod-5joints"])
-def test_load_listing_matches_reference(case: str, tmp_path: Path):
-    hal_file = MOTION / f"{case}.hal"
-    (tmp_path / hal_file.name).write_bytes(hal_file.read_bytes())
-    env = _env(tmp_path, case)
-    proc = _cli(["halrun", "-f", hal_file.name], tmp_path, env)
-    assert proc.returncode == 0, proc.stdout
-    ours = _tables(proc.stdout)
-    ref = _tables(hal_file.with_suffix(".out").read_text())
-    assert len(ref) > 300
-    assert ours == ref
-    assert _shm_left(env) == []
-
-
-# loads the reference refuses too (its stderr in the .out file); our
-# reason for each
-REF_ERRORS = {
-    "motmod-err-num-joints": "motmod: num_joints=17 is out of range (1..16)",
-    "motmod-err-num-dio": "motmod: num_dio=65 is out of range (1..64)",
-    "motmod-err-no-kins": "motmod: no kinematics module is loaded "
-                          "(loadrt trivkins first)",
-    "motmod-err-extrajoints": "motmod: num_extrajoints=1 needs kinematics "
-                              "of type BOTH",
-}
-
-
-@pytest.mark.parametrize("case", sorted(REF_ERRORS))
-def test_load_refusals_like_the_reference(case: str, tmp_path: Path):
-    hal_file = MOTION / f"{case}.hal"
-    assert "rtapi_app_main" in hal_file.with_suffix(".out").read_text() \
-        or "undefined symbol" in hal_file.with_suffix(".out").read_text()
-    (tmp_path / hal_file.name).write_bytes(hal_file.read_bytes())
-    env = _env(tmp_path, case)
-    proc = _cli(["halrun", "-f", hal_file.name], tmp_path, env)
-    assert proc.returncode != 0
-    assert REF_ERRORS[case] in proc.stdout
-    assert _shm_left(env) == []
 
 
 LOAD_ERRORS = [
