@@ -19,7 +19,6 @@ import sys
 import tempfile
 import threading
 import time
-from pathlib import Path
 from typing import Any, Callable, Optional
 
 import pytest
@@ -28,9 +27,9 @@ import halsdk
 import halsdk.compat
 from halsdk import _core
 from halsdk.compat import hal as compat
+from helpers import data_path
 
-REPO = Path(__file__).resolve().parent.parent
-DATA = Path(__file__).resolve().parent / "data" / "compat"
+DATA = data_path("compat")
 TIMEOUT = 10.0          # seconds to wait for anything a child should do
 
 

@@ -1,7 +1,7 @@
-"""Unit tests of the shipped components differential, filter_kalman,
-histobins, feedcomp, orient, gearchange, joyhandle, spindle, at_pid and
-bldc: behaviour stated in Python, with numbers observed on the LinuxCNC 2.9
-reference (the differential tests in tests/complib compare whole runs)."""
+"""Unit tests of the shipped components differential, filter_kalman and
+histobins: behaviour stated in Python, with numbers observed on the LinuxCNC
+2.9 reference (the differential tests in tests/data/complib compare whole
+runs)."""
 
 from __future__ import annotations
 
@@ -10,15 +10,9 @@ import pytest
 
 import halsdk
 from halsdk import _core
+from helpers.components import setup
 
 PERIOD = 1_000_000
-
-
-def setup(hal, comp, *funct, args=()):
-    hal.loadrt(comp, *args)
-    hal.newthread("t", PERIOD)
-    for f in funct:
-        hal.addf(f, "t")
 
 
 # differential ------------------------------------------------------------

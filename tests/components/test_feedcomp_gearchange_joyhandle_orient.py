@@ -1,6 +1,6 @@
 """Unit tests of the shipped components feedcomp, gearchange, joyhandle and
 orient: behaviour stated in Python, with numbers observed on the LinuxCNC
-2.9 reference (the differential tests in tests/complib compare whole runs)."""
+2.9 reference (the differential tests in tests/data/complib compare whole runs)."""
 
 from __future__ import annotations
 
@@ -8,10 +8,10 @@ import math
 
 import numpy as np
 import pytest
-from test_lib_extra import setup
 
 import halsdk
 from halsdk import _core
+from helpers.components import setup
 
 # feedcomp ----------------------------------------------------------------
 

@@ -3,7 +3,7 @@ mux16, mux_generic), decoders (select8, demux), code converters (bin2gray,
 gray2bin), tristate buffers, gates (maj3, match8, logic, lut5) and bit
 operations (bitslice, bitwise).
 
-The reference's exact outputs are checked by tests/complib/*.hal; these
+The reference's exact outputs are checked by tests/data/complib/*.hal; these
 tests state the rules in Python over many inputs."""
 
 from __future__ import annotations

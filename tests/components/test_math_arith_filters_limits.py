@@ -2,8 +2,9 @@
 invert, ddt, integ, lowpass, ilowpass, biquad, limit1, limit2, limit3,
 hypot, near, comp, wcomp): behaviour stated in Python, stepped
 deterministically.  The numbers they must share with LinuxCNC 2.9 are
-checked against its own runs in tests/complib (test_complib.py); these
-tests state the rules those runs showed."""
+checked against its own runs in tests/data/complib
+(golden/test_complib_golden.py); these tests state the rules those runs
+showed."""
 
 from __future__ import annotations
 

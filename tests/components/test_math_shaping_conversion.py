@@ -2,7 +2,7 @@
 weighted_sum, scaled_s32_sums, lincurve, updown, blend, knob2float,
 constant, clarke2/3, clarkeinv, modmath, counter and the conv_* family.
 
-The reference's exact outputs are checked by tests/complib/*.hal; these
+The reference's exact outputs are checked by tests/data/complib/*.hal; these
 tests state the rules in Python."""
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """siggen, encoder, charge_pump and encoder_ratio: behaviour stated in
 Python (the byte-for-byte comparisons with the reference are the
-tests/complib files of the same names)."""
+tests/data/complib files of the same names)."""
 
 from __future__ import annotations
 

@@ -7,7 +7,7 @@ period and the simulated clock (rtapi_get_time) advances by exactly one
 period a cycle, so the clock-reading components (timedelta, latencybins)
 measure no scheduling error at all, and their numbers are exact here.
 The expected values come from the LinuxCNC 2.9 reference, observed with
-``halrun`` (see tests/complib/ for the recorded runs)."""
+``halrun`` (see tests/data/complib/ for the recorded runs)."""
 
 from __future__ import annotations
 

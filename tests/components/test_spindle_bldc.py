@@ -1,6 +1,6 @@
 """Unit tests of the shipped components spindle and bldc: behaviour stated
 in Python, with numbers observed on the LinuxCNC 2.9 reference (the
-differential tests in tests/complib compare whole runs)."""
+differential tests in tests/data/complib compare whole runs)."""
 
 from __future__ import annotations
 

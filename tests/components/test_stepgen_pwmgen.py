@@ -1,6 +1,6 @@
 """stepgen and pwmgen: load lines, interface and behaviour.
 
-The numbers match the LinuxCNC 2.9 reference (see tests/complib/stepgen*.hal
+The numbers match the LinuxCNC 2.9 reference (see tests/data/complib/stepgen*.hal
 and pwmgen*.hal); these tests state the behaviour a machine builder relies
 on, with a fast base thread for make-pulses and a slower servo thread for
 the rest, stepped deterministically.

@@ -4,7 +4,7 @@ multiswitch and estop_latch.
 
 Stepped one 1 ms period at a time; the expected numbers are the ones the
 LinuxCNC 2.9 reference gives for the same inputs (see the differential tests
-in ``tests/complib``)."""
+in ``tests/data/complib``)."""
 
 from __future__ import annotations
 

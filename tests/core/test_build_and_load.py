@@ -13,6 +13,7 @@ import halsdk
 from halsdk import _core
 from halsdk.build import BuildError, build_component
 from halsdk.loader import import_component
+from helpers import data_path
 
 
 def test_cython_gate_by_name_in_a_thread(hal):
@@ -166,7 +167,7 @@ def test_build_errors_name_the_file(tmp_path):
 
 
 def test_build_is_cached(tmp_path):
-    src = os.path.join(os.path.dirname(__file__), "components", "tand2.pyx")
+    src = str(data_path("components", "tand2.pyx"))
     first = build_component(src)
     mtime = os.path.getmtime(first)
     assert build_component(src) == first
@@ -275,7 +276,7 @@ def test_cython_build_in_process_names_the_source(tmp_path, monkeypatch):
         build_component(str(bad))
     assert f"{bad}:2:" in str(info.value)
     assert "halsdk-build-" not in str(info.value)
-    src = os.path.join(os.path.dirname(__file__), "components", "tand2.pyx")
+    src = str(data_path("components", "tand2.pyx"))
     path = build_component(src, name="tand2copy")
     assert os.path.basename(path).startswith("tand2copy.")
     with open(path, "rb") as f:

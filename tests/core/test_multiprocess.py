@@ -27,7 +27,6 @@ import sys
 import threading
 import time
 from collections.abc import Iterator
-from pathlib import Path
 from typing import Any, Callable, Optional
 
 import pytest
@@ -35,8 +34,9 @@ import pytest
 import halsdk
 from halsdk import _core, channel
 from halsdk.errors import ConflictError, InstanceError
+from helpers import data_path
 
-DATA = Path(__file__).parent / "data" / "multiprocess"
+DATA = data_path("multiprocess")
 SHM_DIR = "/dev/shm"
 TIMEOUT = 10.0          # seconds to wait for anything a child should do
 
@@ -405,7 +405,7 @@ def test_attached_process_forwards_host_operations(hal, spawn):
 
 
 def test_attached_process_loads_realtime_module_through_host(hal, spawn):
-    # tand2 is a test component (tests/components), built by conftest.py
+    # tand2 is a test component (tests/data/components), built by conftest.py
     child, _ = start_driver(spawn)
     assert ok(child.call("loadrt", "tand2", count=2)) == ["tand2"]
     comp = hal.component("tand2")

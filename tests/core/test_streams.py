@@ -12,9 +12,9 @@ import pytest
 
 import halsdk
 from halsdk import _core
+from helpers import data_path
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-DATA = os.path.join(HERE, "data", "streams")
+DATA = str(data_path("streams"))
 
 
 def _owner(name: str = "owner") -> int:

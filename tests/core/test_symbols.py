@@ -7,12 +7,14 @@ import ctypes
 import os
 
 import pytest
-from conftest import on_halsdk_path
-from test_halcompile import COMPS, halcompile
 
 import halsdk
 from halsdk import _core
+from helpers import data_path
+from helpers.environment import on_halsdk_path
+from helpers.halcompile import halcompile
 
+COMPS = str(data_path("comps"))
 MODS = ["hcsymexp", "hcsymuse"]
 
 

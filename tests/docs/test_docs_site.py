@@ -18,8 +18,9 @@ import pytest
 
 import halsdk
 from halsdk.build import build_component
+from helpers import REPO
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = str(REPO)
 DOCS = os.path.join(ROOT, "docs")
 PAGES = ["index", "concepts", "tutorial", "components", "halcmd", "halcompile",
          "python-api", "cython-components", "c-components", "motion",

@@ -14,7 +14,6 @@ import time
 import can
 import cantools
 import pytest
-from conftest import ended_at_exit, sigterm
 
 from halsdk.driver import FAULT_OPEN, FAULT_READ, IOLoop
 from halsdk.drivers.candbc import (
@@ -25,9 +24,10 @@ from halsdk.drivers.candbc import (
 )
 from halsdk.drivers.candbc.dbc import find_package_dbc
 from halsdk.types import Direction, HalType
+from helpers import repo_path
+from helpers.processes import ended_at_exit, sigterm
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-EXAMPLE = os.path.join(HERE, "..", "examples", "candbc")
+EXAMPLE = str(repo_path("examples", "candbc"))
 DEMO = find_package_dbc("demo.dbc")
 DB = cantools.database.load_file(DEMO)
 P = "candbc.0."

@@ -23,8 +23,9 @@ from halsdk.drivers.cia402.codes import emcy_text
 from halsdk.drivers.cia402.config import ConfigError, load
 from halsdk.drivers.cia402.driver import Cia402Driver
 from halsdk.testing import private_instance_name
+from helpers import repo_path
 
-EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "cia402"
+EXAMPLE = repo_path("examples", "cia402")
 _channels = iter(range(10**6))
 
 

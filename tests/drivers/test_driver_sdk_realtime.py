@@ -14,8 +14,9 @@ import halsdk
 from halsdk import _core, build
 from halsdk.build import build_component
 from halsdk.errors import HalError, InvalidError
+from helpers import REPO
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = str(REPO)
 EXAMPLE = os.path.join(ROOT, "examples", "rt-driver")
 # rt.pxd as the build finds it: Cython's include path is the folder that
 # holds the installed halsdk package

@@ -23,6 +23,7 @@ from halsdk.driver import (
     IOLoop,
 )
 from halsdk.types import Direction, HalType
+from helpers import repo_path
 
 
 class FakeBoard:
@@ -328,8 +329,7 @@ def test_sigterm_stops_loadusr_process(tmp_path, hal):
 
 def docs_example() -> str:
     """The code block captioned iobox.py in docs/drivers.rst."""
-    here = os.path.dirname(os.path.abspath(__file__))
-    with open(os.path.join(here, "..", "docs", "drivers.rst"),
+    with open(repo_path("docs", "drivers.rst"),
               encoding="utf-8") as f:
         text = f.read()
     start = text.index("   :caption: iobox.py\n")

@@ -14,14 +14,14 @@ import sys
 import threading
 import time
 import tty
-from pathlib import Path
 
 import pytest
 
 from halsdk.drivers.mb2hal import ConfigError, Mb2hal, load_config
 from halsdk.drivers.mb2hal.client import ModbusLink
+from helpers import REPO
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = REPO
 _spec = importlib.util.spec_from_file_location(
     "mb2hal_simulator", ROOT / "examples" / "modbus" / "simulator.py")
 sim = importlib.util.module_from_spec(_spec)

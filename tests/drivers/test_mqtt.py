@@ -27,6 +27,7 @@ from halsdk.drivers.mqtt.broker import Mosquitto, find_mosquitto, free_port
 from halsdk.drivers.mqtt.client import MAX_PENDING
 from halsdk.drivers.mqtt.config import Subscription, parse_args
 from halsdk.drivers.mqtt.payload import MAX_PAYLOAD, PayloadError, parse
+from helpers import repo_path
 
 PREFIX = "t/bridge"
 
@@ -591,8 +592,7 @@ def test_program_errors_start_with_its_name(tmp_path, capsys):
 
 
 def test_example_config_parses():
-    here = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..",
-                        "examples", "mqtt")
+    here = str(repo_path("examples", "mqtt"))
     cfg, _ = parse_args(["-c", os.path.join(here, "bridge.conf")])
     assert cfg.publish == [("", "siggen.0.clock"), ("", "siggen.0.amplitude"),
                            ("signal", "wave")]

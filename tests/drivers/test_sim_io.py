@@ -2,19 +2,17 @@
 
 from __future__ import annotations
 
-import os
-
 import numpy as np
 import pytest
-from conftest import on_halsdk_path
 
 import halsdk
 from halcompile.cli import process
 from halsdk import _core
+from helpers import repo_path
+from helpers.environment import on_halsdk_path
 
 P = "sim-io.0."
-SOURCE = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(
-    __file__))), "drivers", "sim_io.comp")
+SOURCE = str(repo_path("drivers", "sim_io.comp"))
 
 
 @pytest.fixture(scope="module", autouse=True)

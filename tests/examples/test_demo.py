@@ -6,15 +6,15 @@ from __future__ import annotations
 
 import io
 import re
-from pathlib import Path
 
 import pytest
 
 import halsdk.demo
 from halsdk.ini import IniFile
 from halsdk.testing import private_instance_name
+from helpers import repo_path
 
-MILL = Path(__file__).resolve().parents[1] / "examples" / "mill"
+MILL = repo_path("examples", "mill")
 
 
 @pytest.fixture(scope="module")

@@ -8,15 +8,15 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
-from pathlib import Path
 
 import pytest
 
 from halsdk.ini import IniFile
 from halsdk.launcher import Launcher
 from halsdk.testing import private_instance_name
+from helpers import repo_path
 
-MILL = Path(__file__).resolve().parents[1] / "examples" / "mill"
+MILL = repo_path("examples", "mill")
 INI = MILL / "mill.ini"
 JOINTS = range(3)
 

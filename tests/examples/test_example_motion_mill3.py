@@ -8,8 +8,9 @@ import os
 
 import pytest
 
-EXAMPLE = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(
-    __file__))), "examples", "motion", "mill3.py")
+from helpers import repo_path
+
+EXAMPLE = str(repo_path("examples", "motion", "mill3.py"))
 
 
 @pytest.fixture(scope="module")

@@ -10,8 +10,9 @@ import pytest
 
 from halsdk.gcode import Block, GCodeError, Parameters, Program
 from halsdk.gcode.lexer import parse_line
+from helpers import data_path
 
-HERE = Path(__file__).parent / "gcode"
+HERE = data_path("gcode")
 
 
 def run(text: str, params: Parameters | None = None, **options) -> list[Block]:

@@ -1,11 +1,11 @@
 """Differential tests of the component library against the reference.
 
-Every ``tests/complib/NAME.hal`` runs with our ``halrun -f`` in a folder
+Every ``tests/data/complib/NAME.hal`` runs with our ``halrun -f`` in a folder
 holding its inputs; the reference's results of the same run (made by
-``tests/complib/golden.py``) are the goldens:
+``tests/data/complib/golden.py``) are the goldens:
 
 - ``NAME.out``: standard output, compared byte for byte after
-  :func:`test_halcmd.normalize` (component ids, addresses and halcmd's
+  :func:`helpers.halrun.normalize` (component ids, addresses and halcmd's
   pid cannot match);
 - ``NAME.rc``: a non-zero exit status (absent: 0); zero/non-zero must
   match;
@@ -29,10 +29,12 @@ import sys
 from pathlib import Path
 
 import pytest
-from test_halcmd import normalize
-from test_halcmd_corpus import _env
 
-COMPLIB = Path(__file__).parent / "complib"
+from helpers import data_path, repo_path
+from helpers.halrun import normalize
+from helpers.halrun import tools_env as _env
+
+COMPLIB = data_path("complib")
 GOLDEN = (".out", ".err", ".rc")
 CASES = sorted(p for p in COMPLIB.glob("*.hal")
                if p.with_suffix(".out").exists())
@@ -109,7 +111,7 @@ LOAD_ARGS = {
     "pwmgen": "output_type=0", "modmath": "mod_dir=1", "debounce": "cfg=1",
     "weighted_sum": "wsum_sizes=1", "watchdog": "num_inputs=1",
 }
-COMPONENTS = Path(__file__).parent.parent / "components"
+COMPONENTS = repo_path("components")
 
 
 def _cases_of(name: str) -> list[Path]:

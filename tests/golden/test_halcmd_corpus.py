@@ -9,7 +9,7 @@ folder holding the inputs.  Here our ``halrun`` runs them the same way.
 
 The other tests cover commands and options whose reference output cannot
 be a golden (help texts, debugging output) or that the reference lacks;
-``tests/test_halcmd_coverage.py`` refers to them by name.
+``tests/halcmd/test_halcmd_coverage.py`` refers to them by name.
 """
 
 from __future__ import annotations
@@ -25,27 +25,13 @@ import pytest
 
 from halsdk import _core
 from halsdk.halcmd import Executor
+from helpers import data_path
+from helpers.halrun import tools_env as _env
 
-STREAMS = Path(__file__).parent / "data" / "streams"
+STREAMS = data_path("streams")
 NOTE = "Note: Using POSIX non-realtime"
 STREAM_GOLDENS = sorted(p for p in STREAMS.glob("*.hal")
                         if p.with_suffix(".out").exists())
-TOOLS = ("halsampler", "halstreamer")
-
-
-def _env(name: str, tools: Path) -> dict:
-    env = dict(os.environ)
-    env["HALSDK_INSTANCE"] = f"tc-{os.getpid()}-{name}"
-    # the tools of this Python's halsdk, first on PATH: a halsampler of
-    # another installation (an older one on PATH) would not attach
-    tools.mkdir(exist_ok=True)
-    for tool in TOOLS:
-        script = tools / tool
-        script.write_text(f'#!/bin/sh\nexec "{sys.executable}" -m '
-                          f'halsdk.tools.{tool} "$@"\n')
-        script.chmod(0o755)
-    env["PATH"] = f"{tools}{os.pathsep}{env.get('PATH', '')}"
-    return env
 
 
 def _shm_left(env: dict) -> list[str]:

@@ -23,15 +23,15 @@ import sys
 import time
 
 import pytest
-from conftest import on_halsdk_path
 
 from halcompile import parse, parse_file
 from halsdk.build import extension_suffix
 from halsdk.errors import InvalidError
+from helpers import data_path
+from helpers.environment import on_halsdk_path
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-COMPS = os.path.join(HERE, "comps")
-DATA = os.path.join(HERE, "data", "halcompile")
+COMPS = str(data_path("comps"))
+DATA = str(data_path("halcompile"))
 PERIOD = 1_000_000
 FPERIOD = PERIOD * 1e-9
 
@@ -636,7 +636,7 @@ def test_userspace_extra_compile_and_link_args(hal, corpus):
 def test_userspace_against_the_reference(corpus, tmp_path, name):
     """NAME.hal run by our halrun prints what the reference's halrun
     printed for the reference's build of the same .comp (NAME.out)."""
-    from test_halcmd import normalize
+    from helpers.halrun import normalize
     for file in (name, name + extension_suffix()):
         shutil.copy2(os.path.join(corpus, file), tmp_path / file)
     shutil.copy2(os.path.join(DATA, name + ".hal"), tmp_path / "run.hal")

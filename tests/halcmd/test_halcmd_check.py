@@ -1,7 +1,7 @@
 """The netlist checker (``halcmd --check FILE``, ``halrun --check FILE``)
 and the long-name warning of the executor.
 
-Inputs are in ``tests/halfiles_check/``; every run copies them to a temp
+Inputs are in ``tests/data/halfiles_check/``; every run copies them to a temp
 folder and runs there in a subprocess with its own ``HALSDK_INSTANCE``.
 """
 
@@ -16,7 +16,9 @@ from pathlib import Path
 
 import pytest
 
-CHECK_FILES = Path(__file__).parent / "halfiles_check"
+from helpers import data_path
+
+CHECK_FILES = data_path("halfiles_check")
 
 
 @pytest.fixture

@@ -2,7 +2,7 @@
 
 Every command, command form and option of the two reference manuals is
 listed below as data.  Each must be used by at least one HAL file of the
-differential corpus (``tests/halfiles/*.hal`` and
+differential corpus (``tests/data/halfiles/*.hal`` and
 ``tests/data/streams/*.hal`` that have a golden ``.out``), or be exercised
 by a named test (whose source must contain the given text), or be listed
 in ``UNSUPPORTED`` with the reason.  The test fails when a golden or a
@@ -20,9 +20,9 @@ import pytest
 
 from halsdk.halcmd import logical_lines
 from halsdk.halcmd.commands import ARG_COUNTS
+from helpers import data_path, find_test_module
 
-TESTS = Path(__file__).parent
-CORPUS_DIRS = (TESTS / "halfiles", TESTS / "data" / "streams")
+CORPUS_DIRS = (data_path("halfiles"), data_path("streams"))
 
 # Every command of halcmd(1), plus the ones of the issue
 # (echo/unecho/quit/exit/newinst/delinst/setexact_for_test_suite_only).
@@ -232,7 +232,7 @@ def corpus() -> Corpus:
 
 def _test_source(file: str, func: str) -> str:
     """Source text of test function ``func`` of ``tests/file``."""
-    text = (TESTS / file).read_text()
+    text = find_test_module(file).read_text()
     for node in ast.walk(ast.parse(text)):
         if isinstance(node, ast.FunctionDef) and node.name == func:
             return ast.get_source_segment(text, node) or ""

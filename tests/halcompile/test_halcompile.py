@@ -8,34 +8,21 @@ import subprocess
 import sys
 
 import pytest
-from conftest import on_halsdk_path
 
 import halsdk
 from halcompile import CompError, parse, parse_file
 from halcompile.cli import main
 from halcompile.model import c_identifier, hal_format, hal_identifier
 from halsdk.build import extension_suffix
+from helpers import data_path
+from helpers.environment import on_halsdk_path
+from helpers.halcompile import halcompile
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-COMPS = os.path.join(HERE, "comps")
+COMPS = str(data_path("comps"))
 GOOD = ["hcddt", "hcmux2", "hcarrays", "hcsetup", "hcsingle", "hcsingle2",
         "hclogic", "hcdata", "hal_hcloop", "hcrtapp", "hcnames", "hcdelay",
         "hcslice", "hcclamp"]
 PERIOD = 1_000_000
-
-
-def halcompile(*args: str, cwd: str) -> subprocess.CompletedProcess:
-    """Run ``python -m halcompile`` the way a user runs the command."""
-    env = dict(os.environ)
-    # the packages this test imported (installed, or an editable tree):
-    # never the repository root, which holds no compiled core in a clone
-    import halcompile as hc
-    import halsdk
-    dirs = {os.path.dirname(os.path.dirname(m.__file__)) for m in (hc, halsdk)}
-    env["PYTHONPATH"] = os.pathsep.join([*sorted(dirs),
-                                         env.get("PYTHONPATH", "")])
-    return subprocess.run([sys.executable, "-m", "halcompile", *args],
-                          cwd=cwd, env=env, capture_output=True, text=True)
 
 
 @pytest.fixture(scope="module")
@@ -418,7 +405,7 @@ def test_compile_c_file_and_install(tmp_path, monkeypatch, hal):
     data = tmp_path / "data"
     monkeypatch.setenv("XDG_DATA_HOME", str(data))
     proc = halcompile("--install",
-                      os.path.join(HERE, "components", "cscale.c"),
+                      str(data_path("components", "cscale.c")),
                       cwd=str(tmp_path))
     assert proc.returncode == 0, proc.stderr
     installed = data / "halsdk" / "components" / ("cscale" +

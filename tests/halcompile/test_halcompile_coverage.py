@@ -1,6 +1,6 @@
 """Coverage audit of the halcompile corpus: every declaration, option,
 type and naming rule of the reference's ``.comp`` manual (and the habits of
-real files the issue lists) appears in at least one ``tests/comps/*.comp``
+real files the issue lists) appears in at least one ``tests/data/comps/*.comp``
 that a test compiles and loads, or is listed here as unsupported with the
 reason."""
 
@@ -15,9 +15,9 @@ import pytest
 
 from halcompile import CompError, parse_file
 from halcompile.model import Component
+from helpers import data_path, find_test_module
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-COMPS = os.path.join(HERE, "comps")
+COMPS = str(data_path("comps"))
 #: test modules that compile (and load) corpus files; the documentation
 #: tests only document them, so they do not count
 #: files that exist to fail (syntax error, C error)
@@ -30,7 +30,7 @@ def _compiled() -> dict[str, Component]:
     """The good corpus files a compiling test names, parsed."""
     text = ""
     for name in COMPILING_TESTS:
-        with open(os.path.join(HERE, name), encoding="utf-8") as f:
+        with open(find_test_module(name), encoding="utf-8") as f:
             text += f.read()
     out = {}
     for path in sorted(glob.glob(os.path.join(COMPS, "*.comp"))):

@@ -6,16 +6,16 @@ from __future__ import annotations
 import os
 
 import pytest
-from conftest import on_halsdk_path
-from test_halcompile import halcompile
 
 from halcompile import CompError, parse
 from halcompile.gen_cython import CythonSourceError, generate, split_code
 from halsdk.build import extension_suffix
 from halsdk.errors import InvalidError
+from helpers import REPO, data_path
+from helpers.environment import on_halsdk_path
+from helpers.halcompile import halcompile
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-COMPS = os.path.join(HERE, "comps")
+COMPS = str(data_path("comps"))
 PERIOD = 1_000_000
 
 
@@ -176,7 +176,7 @@ def test_split_code_blocks():
 
 
 def test_the_documented_example_works(hal, tmp_path, monkeypatch):
-    with open(os.path.join(os.path.dirname(HERE), "docs", "halcompile.rst"),
+    with open(os.path.join(REPO, "docs", "halcompile.rst"),
               encoding="utf-8") as f:
         rst = f.read()
     start = rst.index("   component lowpass2")

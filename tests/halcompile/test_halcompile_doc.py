@@ -27,9 +27,9 @@ from halcompile.gen_doc import (
     man_page,
     rst_page,
 )
+from helpers import data_path
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-COMPS = os.path.join(HERE, "comps")
+COMPS = str(data_path("comps"))
 #: comps that must be in the corpus (the corpus grows: every .comp that
 #: parses is documented)
 KNOWN = {"hal_hcloop", "hcarrays", "hcbadc", "hcclamp", "hcdata", "hcddt",

@@ -18,9 +18,9 @@ from halcompile import CompError, parse
 from halcompile.gen_c import generate
 from halsdk.build import extension_suffix
 from halsdk.errors import LoadError
+from helpers import data_path
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-COMPS = os.path.join(HERE, "comps")
+COMPS = str(data_path("comps"))
 
 
 def _env(**extra: str) -> dict:

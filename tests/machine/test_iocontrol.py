@@ -11,8 +11,9 @@ import pytest
 import halsdk
 from halsdk.machine import IoControl, IoControlError, IoState, ToolTable
 from halsdk.machine.iocontrol import PINS, ToolState
+from helpers import data_path
 
-DATA = Path(__file__).parent / "machine"
+DATA = data_path("machine")
 P = "iocontrol.0."
 
 

@@ -14,8 +14,9 @@ import pytest
 
 from halsdk.launcher import Launcher, LaunchError
 from halsdk.testing import private_instance_name
+from helpers import repo_path
 
-MILL = Path(__file__).resolve().parents[1] / "examples" / "motion" / "mill3.ini"
+MILL = repo_path("examples", "motion", "mill3.ini")
 
 
 def halsdk_run(tmp_path: Path, *args: str, **kw) -> subprocess.Popen:

@@ -6,7 +6,6 @@ machine Z."""
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
 import pytest
@@ -19,9 +18,8 @@ from halsdk.machine import (
     TaskState,
     ToolTable,
 )
-
-sys.path.insert(0, str(Path(__file__).parent))
-from motion_trace import looped_machine  # noqa: E402
+from helpers import repo_path
+from helpers.motion_trace import looped_machine
 
 P = "iocontrol.0."
 PROBE_Z = 12.0          # machine Z below which the probe is tripped
@@ -348,7 +346,7 @@ def test_from_launcher_reads_the_emcio_section(tmp_path, monkeypatch):
     from halsdk.launcher import Launcher
     from halsdk.testing import private_instance_name
     monkeypatch.setenv("HALSDK_INSTANCE", private_instance_name())
-    mill = Path(__file__).resolve().parents[1] / "examples" / "motion"
+    mill = repo_path("examples", "motion")
     text = (mill / "mill3.ini").read_text().replace(
         "HALFILE = mill3.hal", f"HALFILE = {mill / 'mill3.hal'}")
     text += "\n[EMCIO]\nTOOL_TABLE = tool.tbl\nRANDOM_TOOLCHANGER = 1\n"

@@ -10,8 +10,9 @@ import pytest
 
 from halsdk.errors import HalError
 from halsdk.machine.tooltable import ToolEntry, ToolTable, ToolTableError
+from helpers import data_path
 
-DATA = Path(__file__).parent / "machine"
+DATA = data_path("machine")
 
 
 def table(tmp_path: Path, name: str, random: bool) -> ToolTable:

@@ -9,7 +9,6 @@ import math
 
 import numpy as np
 import pytest
-from test_motion_freeplan import DPTR, Freeplan, build_library
 
 from halsdk.errors import HalError
 from halsdk.motion.compfile import (
@@ -18,6 +17,7 @@ from halsdk.motion.compfile import (
     parse_comp,
     read_comp_file,
 )
+from helpers.freeplan import DPTR, Freeplan, build_library
 
 EINVAL = 22
 REL = 1e-9

@@ -3,16 +3,15 @@ the file and line, and sent to motmod."""
 
 from __future__ import annotations
 
-import os
 import re
 
 import pytest
 
 from halsdk.motion import Motion, MotionIniError, read_motion_ini
 from halsdk.motion.compfile import CompFileError
+from helpers import repo_path
 
-EXAMPLE = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(
-    __file__))), "examples", "motion", "mill3.ini")
+EXAMPLE = str(repo_path("examples", "motion", "mill3.ini"))
 
 GOOD = """\
 [KINS]

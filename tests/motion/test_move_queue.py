@@ -13,7 +13,6 @@ import math
 
 import numpy as np
 import pytest
-from motion_trace import looped_machine
 
 from halsdk.motion import (
     InputWait,
@@ -21,6 +20,7 @@ from halsdk.motion import (
     QueueRejected,
     Rejected,
 )
+from helpers.motion_trace import looped_machine
 
 VMAX, AMAX = 100.0, 5000.0
 

@@ -1,6 +1,6 @@
 """Part programs of lines and arcs on a simulated machine (issue 7, Tests).
 
-Each test builds a machine with tests/motion_trace.py (motmod, trivkins,
+Each test builds a machine with tests/helpers/motion_trace.py (motmod, trivkins,
 homemod, tpmod; every joint's motor-pos-cmd looped to its motor-pos-fb;
 homed on the spot; coordinated mode), queues a program through
 halsdk.motion, steps the servo thread deterministically and checks the
@@ -19,11 +19,11 @@ import sys
 import numpy as np
 import pytest
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import motion_trace as mt  # noqa: E402
-from motion_trace import Arc, Line, PathMode, Probe  # noqa: E402
+from helpers import REPO
+from helpers import motion_trace as mt
+from helpers.motion_trace import Arc, Line, PathMode, Probe
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = str(REPO)
 CONTOUR = os.path.join(ROOT, "examples", "contour", "contour.py")
 
 # a small mill: X Y fast, Z slower (mm, s)
