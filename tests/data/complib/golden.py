@@ -1,9 +1,9 @@
 #!/usr/bin/env python3
 """Make the reference goldens of component differential tests.
 
-    python tests/complib/golden.py NAME [NAME ...]
+    python tests/data/complib/golden.py NAME [NAME ...]
 
-For each ``tests/complib/NAME.hal``: copy it and its inputs (every
+For each ``tests/data/complib/NAME.hal``: copy it and its inputs (every
 ``NAME.*`` and ``NAME-*.*`` file that is not a golden) into an empty
 folder, run the reference's ``halrun -f NAME.hal`` there and write
 
