@@ -6,10 +6,10 @@ import os
 import sys
 
 import pytest
-
-from halsdk.build import build_component
 from helpers import data_path
 from helpers.environment import on_halsdk_path
+
+from halsdk.build import build_component
 
 COMPONENTS = str(data_path("components"))
 TEST_COMPONENTS = ["tand2.pyx", "tcounter.pyx", "tlowpass.pyx", "cscale.c"]

@@ -22,12 +22,12 @@ import time
 from typing import Any, Callable, Optional
 
 import pytest
+from helpers import data_path
 
 import halsdk
 import halsdk.compat
 from halsdk import _core
 from halsdk.compat import hal as compat
-from helpers import data_path
 
 DATA = data_path("compat")
 TIMEOUT = 10.0          # seconds to wait for anything a child should do

@@ -7,10 +7,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from helpers.components import setup
 
 import halsdk
 from halsdk import _core
-from helpers.components import setup
 
 PERIOD = 1_000_000
 

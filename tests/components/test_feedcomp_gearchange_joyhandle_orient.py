@@ -8,10 +8,10 @@ import math
 
 import numpy as np
 import pytest
+from helpers.components import setup
 
 import halsdk
 from halsdk import _core
-from helpers.components import setup
 
 # feedcomp ----------------------------------------------------------------
 

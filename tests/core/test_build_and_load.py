@@ -8,12 +8,12 @@ import sys
 import time
 
 import pytest
+from helpers import data_path
 
 import halsdk
 from halsdk import _core
 from halsdk.build import BuildError, build_component
 from halsdk.loader import import_component
-from helpers import data_path
 
 
 def test_cython_gate_by_name_in_a_thread(hal):

@@ -30,11 +30,11 @@ from collections.abc import Iterator
 from typing import Any, Callable, Optional
 
 import pytest
+from helpers import data_path
 
 import halsdk
 from halsdk import _core, channel
 from halsdk.errors import ConflictError, InstanceError
-from helpers import data_path
 
 DATA = data_path("multiprocess")
 SHM_DIR = "/dev/shm"

@@ -9,10 +9,10 @@ import time
 
 import numpy as np
 import pytest
+from helpers import data_path
 
 import halsdk
 from halsdk import _core
-from helpers import data_path
 
 DATA = str(data_path("streams"))
 

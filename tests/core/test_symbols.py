@@ -7,12 +7,12 @@ import ctypes
 import os
 
 import pytest
-
-import halsdk
-from halsdk import _core
 from helpers import data_path
 from helpers.environment import on_halsdk_path
 from helpers.halcompile import halcompile
+
+import halsdk
+from halsdk import _core
 
 COMPS = str(data_path("comps"))
 MODS = ["hcsymexp", "hcsymuse"]

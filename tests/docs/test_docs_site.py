@@ -15,10 +15,10 @@ import sys
 import textwrap
 
 import pytest
+from helpers import REPO
 
 import halsdk
 from halsdk.build import build_component
-from helpers import REPO
 
 ROOT = str(REPO)
 DOCS = os.path.join(ROOT, "docs")

@@ -14,6 +14,8 @@ import time
 import can
 import cantools
 import pytest
+from helpers import repo_path
+from helpers.processes import ended_at_exit, sigterm
 
 from halsdk.driver import FAULT_OPEN, FAULT_READ, IOLoop
 from halsdk.drivers.candbc import (
@@ -24,8 +26,6 @@ from halsdk.drivers.candbc import (
 )
 from halsdk.drivers.candbc.dbc import find_package_dbc
 from halsdk.types import Direction, HalType
-from helpers import repo_path
-from helpers.processes import ended_at_exit, sigterm
 
 EXAMPLE = str(repo_path("examples", "candbc"))
 DEMO = find_package_dbc("demo.dbc")

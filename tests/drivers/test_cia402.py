@@ -15,6 +15,7 @@ from pathlib import Path
 
 import can
 import pytest
+from helpers import repo_path
 
 from halsdk.driver import IOLoop
 from halsdk.drivers.cia402 import statemachine as sm
@@ -23,7 +24,6 @@ from halsdk.drivers.cia402.codes import emcy_text
 from halsdk.drivers.cia402.config import ConfigError, load
 from halsdk.drivers.cia402.driver import Cia402Driver
 from halsdk.testing import private_instance_name
-from helpers import repo_path
 
 EXAMPLE = repo_path("examples", "cia402")
 _channels = iter(range(10**6))

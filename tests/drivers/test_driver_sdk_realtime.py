@@ -9,12 +9,12 @@ import sys
 import textwrap
 
 import pytest
+from helpers import REPO
 
 import halsdk
 from halsdk import _core, build
 from halsdk.build import build_component
 from halsdk.errors import HalError, InvalidError
-from helpers import REPO
 
 ROOT = str(REPO)
 EXAMPLE = os.path.join(ROOT, "examples", "rt-driver")

@@ -11,6 +11,7 @@ import textwrap
 import time
 
 import pytest
+from helpers import repo_path
 
 from halsdk.driver import (
     FAULT_NONE,
@@ -23,7 +24,6 @@ from halsdk.driver import (
     IOLoop,
 )
 from halsdk.types import Direction, HalType
-from helpers import repo_path
 
 
 class FakeBoard:

@@ -16,10 +16,10 @@ import time
 import tty
 
 import pytest
+from helpers import REPO
 
 from halsdk.drivers.mb2hal import ConfigError, Mb2hal, load_config
 from halsdk.drivers.mb2hal.client import ModbusLink
-from helpers import REPO
 
 ROOT = REPO
 _spec = importlib.util.spec_from_file_location(

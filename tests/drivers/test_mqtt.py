@@ -17,6 +17,7 @@ from typing import Any, Callable
 
 import paho.mqtt.client as mqtt
 import pytest
+from helpers import repo_path
 from paho.mqtt.enums import CallbackAPIVersion
 
 import halsdk
@@ -27,7 +28,6 @@ from halsdk.drivers.mqtt.broker import Mosquitto, find_mosquitto, free_port
 from halsdk.drivers.mqtt.client import MAX_PENDING
 from halsdk.drivers.mqtt.config import Subscription, parse_args
 from halsdk.drivers.mqtt.payload import MAX_PAYLOAD, PayloadError, parse
-from helpers import repo_path
 
 PREFIX = "t/bridge"
 

@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from helpers import repo_path
+from helpers.environment import on_halsdk_path
 
 import halsdk
 from halcompile.cli import process
 from halsdk import _core
-from helpers import repo_path
-from helpers.environment import on_halsdk_path
 
 P = "sim-io.0."
 SOURCE = str(repo_path("drivers", "sim_io.comp"))

@@ -12,13 +12,13 @@ import time
 from pathlib import Path
 
 import pytest
+from helpers import data_path
+from helpers.processes import ended_at_exit, sigterm
 
 from halsdk.driver import FAULT_NONE, FAULT_OPEN, FAULT_READ, IOLoop
 from halsdk.drivers.whb04b import BUTTON_NAMES, FakeBackend, Whb04bDriver
 from halsdk.drivers.whb04b.fake import ScriptError, load_script, parse_script
 from halsdk.types import Direction, HalType
-from helpers import data_path
-from helpers.processes import ended_at_exit, sigterm
 
 DATA = data_path("whb04b")
 P = "whb04b.0."

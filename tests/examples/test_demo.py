@@ -8,11 +8,11 @@ import io
 import re
 
 import pytest
+from helpers import repo_path
 
 import halsdk.demo
 from halsdk.ini import IniFile
 from halsdk.testing import private_instance_name
-from helpers import repo_path
 
 MILL = repo_path("examples", "mill")
 

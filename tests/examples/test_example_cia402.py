@@ -15,14 +15,14 @@ import time
 from pathlib import Path
 
 import pytest
+from helpers import repo_path
+from helpers.processes import ended_at_exit, sigterm
 
 from halsdk import _core
 from halsdk.ini import IniFile
 from halsdk.launcher import Launcher
 from halsdk.machine import InterpState, Machine, TaskMode, TaskState
 from halsdk.testing import private_instance_name
-from helpers import repo_path
-from helpers.processes import ended_at_exit, sigterm
 
 EXAMPLE = repo_path("examples", "cia402")
 FILES = ("machine.ini", "machine.hal", "drives.ini", "square.ngc")

@@ -10,11 +10,11 @@ import subprocess
 import sys
 
 import pytest
+from helpers import repo_path
 
 from halsdk.ini import IniFile
 from halsdk.launcher import Launcher
 from halsdk.testing import private_instance_name
-from helpers import repo_path
 
 MILL = repo_path("examples", "mill")
 INI = MILL / "mill.ini"

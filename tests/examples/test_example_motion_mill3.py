@@ -7,7 +7,6 @@ import importlib.util
 import os
 
 import pytest
-
 from helpers import repo_path
 
 EXAMPLE = str(repo_path("examples", "motion", "mill3.py"))

@@ -7,10 +7,10 @@ import os
 from pathlib import Path
 
 import pytest
+from helpers import data_path
 
 from halsdk.gcode import Block, GCodeError, Parameters, Program
 from halsdk.gcode.lexer import parse_line
-from helpers import data_path
 
 HERE = data_path("gcode")
 

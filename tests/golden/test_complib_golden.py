@@ -29,7 +29,6 @@ import sys
 from pathlib import Path
 
 import pytest
-
 from helpers import data_path, repo_path
 from helpers.halrun import normalize
 from helpers.halrun import tools_env as _env

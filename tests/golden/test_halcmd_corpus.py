@@ -22,11 +22,11 @@ import time
 from pathlib import Path
 
 import pytest
+from helpers import data_path
+from helpers.halrun import tools_env as _env
 
 from halsdk import _core
 from halsdk.halcmd import Executor
-from helpers import data_path
-from helpers.halrun import tools_env as _env
 
 STREAMS = data_path("streams")
 NOTE = "Note: Using POSIX non-realtime"

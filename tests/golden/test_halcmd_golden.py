@@ -20,7 +20,6 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-
 from helpers import data_path
 from helpers.halrun import NOTE, halcmd_env, normalize, run_cli, shm_left
 

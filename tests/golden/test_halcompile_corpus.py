@@ -23,12 +23,12 @@ import sys
 import time
 
 import pytest
+from helpers import data_path
+from helpers.environment import on_halsdk_path
 
 from halcompile import parse, parse_file
 from halsdk.build import extension_suffix
 from halsdk.errors import InvalidError
-from helpers import data_path
-from helpers.environment import on_halsdk_path
 
 COMPS = str(data_path("comps"))
 DATA = str(data_path("halcompile"))

@@ -10,7 +10,6 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-
 from helpers import data_path
 from helpers.halrun import halcmd_env as _env
 from helpers.halrun import normalize

@@ -9,7 +9,6 @@ import re
 from pathlib import Path
 
 import pytest
-
 from helpers import data_path
 from helpers.halrun import halcmd_env as _env
 from helpers.halrun import normalize

@@ -11,13 +11,13 @@ import subprocess
 import sys
 
 import pytest
+from helpers.halrun import halcmd_env as _env
+from helpers.halrun import run_cli as _cli
+from helpers.halrun import shm_left as _shm_left
 
 from halsdk import _core, halcmd
 from halsdk.halcmd import Executor, logical_lines, parse_value, tokenize
 from halsdk.halcmd.lexer import IniFile, SubstitutionError
-from helpers.halrun import halcmd_env as _env
-from helpers.halrun import run_cli as _cli
-from helpers.halrun import shm_left as _shm_left
 
 # ---------------------------------------------------------------- lexer
 

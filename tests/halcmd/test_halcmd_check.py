@@ -15,7 +15,6 @@ import zlib
 from pathlib import Path
 
 import pytest
-
 from helpers import data_path
 
 CHECK_FILES = data_path("halfiles_check")

@@ -17,10 +17,10 @@ from pathlib import Path
 from typing import Callable
 
 import pytest
+from helpers import data_path, find_test_module
 
 from halsdk.halcmd import logical_lines
 from halsdk.halcmd.commands import ARG_COUNTS
-from helpers import data_path, find_test_module
 
 CORPUS_DIRS = (data_path("halfiles"), data_path("streams"))
 

@@ -8,15 +8,15 @@ import subprocess
 import sys
 
 import pytest
+from helpers import data_path
+from helpers.environment import on_halsdk_path
+from helpers.halcompile import halcompile
 
 import halsdk
 from halcompile import CompError, parse, parse_file
 from halcompile.cli import main
 from halcompile.model import c_identifier, hal_format, hal_identifier
 from halsdk.build import extension_suffix
-from helpers import data_path
-from helpers.environment import on_halsdk_path
-from helpers.halcompile import halcompile
 
 COMPS = str(data_path("comps"))
 GOOD = ["hcddt", "hcmux2", "hcarrays", "hcsetup", "hcsingle", "hcsingle2",

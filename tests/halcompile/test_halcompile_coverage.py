@@ -12,10 +12,10 @@ import re
 from typing import Callable
 
 import pytest
+from helpers import data_path, find_test_module
 
 from halcompile import CompError, parse_file
 from halcompile.model import Component
-from helpers import data_path, find_test_module
 
 COMPS = str(data_path("comps"))
 #: test modules that compile (and load) corpus files; the documentation

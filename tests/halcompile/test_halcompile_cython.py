@@ -6,14 +6,14 @@ from __future__ import annotations
 import os
 
 import pytest
+from helpers import REPO, data_path
+from helpers.environment import on_halsdk_path
+from helpers.halcompile import halcompile
 
 from halcompile import CompError, parse
 from halcompile.gen_cython import CythonSourceError, generate, split_code
 from halsdk.build import extension_suffix
 from halsdk.errors import InvalidError
-from helpers import REPO, data_path
-from helpers.environment import on_halsdk_path
-from helpers.halcompile import halcompile
 
 COMPS = str(data_path("comps"))
 PERIOD = 1_000_000

@@ -18,6 +18,7 @@ import subprocess
 import sys
 
 import pytest
+from helpers import data_path
 
 from halcompile import CompError, gen_doc, parse_file
 from halcompile.gen_doc import (
@@ -27,7 +28,6 @@ from halcompile.gen_doc import (
     man_page,
     rst_page,
 )
-from helpers import data_path
 
 COMPS = str(data_path("comps"))
 #: comps that must be in the corpus (the corpus grows: every .comp that

@@ -13,12 +13,12 @@ import sys
 import time
 
 import pytest
+from helpers import data_path
 
 from halcompile import CompError, parse
 from halcompile.gen_c import generate
 from halsdk.build import extension_suffix
 from halsdk.errors import LoadError
-from helpers import data_path
 
 COMPS = str(data_path("comps"))
 

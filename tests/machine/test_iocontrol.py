@@ -7,11 +7,11 @@ import shutil
 from pathlib import Path
 
 import pytest
+from helpers import data_path
 
 import halsdk
 from halsdk.machine import IoControl, IoControlError, IoState, ToolTable
 from halsdk.machine.iocontrol import PINS, ToolState
-from helpers import data_path
 
 DATA = data_path("machine")
 P = "iocontrol.0."

@@ -11,10 +11,10 @@ import time
 from pathlib import Path
 
 import pytest
+from helpers import repo_path
 
 from halsdk.launcher import Launcher, LaunchError
 from halsdk.testing import private_instance_name
-from helpers import repo_path
 
 MILL = repo_path("examples", "motion", "mill3.ini")
 

@@ -9,6 +9,8 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
+from helpers import repo_path
+from helpers.motion_trace import looped_machine
 
 from halsdk.machine import (
     InterpState,
@@ -18,8 +20,6 @@ from halsdk.machine import (
     TaskState,
     ToolTable,
 )
-from helpers import repo_path
-from helpers.motion_trace import looped_machine
 
 P = "iocontrol.0."
 PROBE_Z = 12.0          # machine Z below which the probe is tripped

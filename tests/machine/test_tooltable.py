@@ -7,10 +7,10 @@ import shutil
 from pathlib import Path
 
 import pytest
+from helpers import data_path
 
 from halsdk.errors import HalError
 from halsdk.machine.tooltable import ToolEntry, ToolTable, ToolTableError
-from helpers import data_path
 
 DATA = data_path("machine")
 

@@ -9,6 +9,7 @@ import math
 
 import numpy as np
 import pytest
+from helpers.freeplan import DPTR, Freeplan, build_library
 
 from halsdk.errors import HalError
 from halsdk.motion.compfile import (
@@ -17,7 +18,6 @@ from halsdk.motion.compfile import (
     parse_comp,
     read_comp_file,
 )
-from helpers.freeplan import DPTR, Freeplan, build_library
 
 EINVAL = 22
 REL = 1e-9

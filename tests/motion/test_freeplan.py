@@ -16,7 +16,6 @@ import math
 
 import numpy as np
 import pytest
-
 from helpers.freeplan import DPTR, Freeplan, build_library
 
 FP_TRAPEZOID = 0

@@ -17,11 +17,11 @@ import random
 from pathlib import Path
 
 import pytest
+from helpers import data_path, repo_path
+from helpers.environment import on_halsdk_path
 
 import halsdk
 from halsdk import _core
-from helpers import data_path, repo_path
-from helpers.environment import on_halsdk_path
 
 MOTION = data_path("motion")
 AXES = "x y z a b c u v w".split()

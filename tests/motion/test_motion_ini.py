@@ -6,10 +6,10 @@ from __future__ import annotations
 import re
 
 import pytest
+from helpers import repo_path
 
 from halsdk.motion import Motion, MotionIniError, read_motion_ini
 from halsdk.motion.compfile import CompFileError
-from helpers import repo_path
 
 EXAMPLE = str(repo_path("examples", "motion", "mill3.ini"))
 

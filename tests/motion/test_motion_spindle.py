@@ -9,13 +9,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from helpers.motion_trace import looped_machine
 
 from halsdk.motion import (
     MotionError,
     OrientState,
     Rejected,
 )
-from helpers.motion_trace import looped_machine
 
 VMAX, AMAX = 50.0, 1000.0
 

@@ -15,10 +15,10 @@ import re
 
 import numpy as np
 import pytest
+from helpers import data_path
 
 import halsdk
 from halsdk import _core
-from helpers import data_path
 
 MOTION = data_path("motion")
 DT = 0.001                      # servo period of the tests (s)

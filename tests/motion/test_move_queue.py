@@ -13,6 +13,7 @@ import math
 
 import numpy as np
 import pytest
+from helpers.motion_trace import looped_machine
 
 from halsdk.motion import (
     InputWait,
@@ -20,7 +21,6 @@ from halsdk.motion import (
     QueueRejected,
     Rejected,
 )
-from helpers.motion_trace import looped_machine
 
 VMAX, AMAX = 100.0, 5000.0
 

@@ -18,7 +18,6 @@ import sys
 
 import numpy as np
 import pytest
-
 from helpers import REPO
 from helpers import motion_trace as mt
 from helpers.motion_trace import Arc, Line, PathMode, Probe
