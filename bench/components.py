@@ -244,7 +244,7 @@ def _wait_for_reference() -> None:
         time.sleep(0.5)
 
 
-#: one reference HAL at a time on a machine: the lock tests/complib's
+#: one reference HAL at a time on a machine: the lock tests/data/complib's
 #: golden.py takes too
 LOCK = "/tmp/halsdk-reference.lock"
 

@@ -5,8 +5,8 @@ Three C-bodied ``.comp`` files of different size are compiled with
 ``halcompile --compile`` (wall time of the whole program, start-up
 included; median of ``--repeat`` runs, the spread beside it):
 
-* small: ``tests/comps/hcclamp.comp`` (one function, 4 pins/params);
-* medium: ``tests/comps/hcrtapp.comp`` (``option rtapi_app no``: its own
+* small: ``tests/data/comps/hcclamp.comp`` (one function, 4 pins/params);
+* medium: ``tests/data/comps/hcrtapp.comp`` (``option rtapi_app no``: its own
   ``rtapi_app_main``, a module parameter, a function);
 * large: a file generated into the run's temp folder (``generate()``):
   ``--pins`` pin pairs, ``--functions`` functions with a few lines each.
@@ -47,7 +47,7 @@ from typing import Optional
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(HERE)
-COMPS = os.path.join(REPO, "tests", "comps")
+COMPS = os.path.join(REPO, "tests", "data", "comps")
 REFERENCE_HALCOMPILE = "/usr/bin/halcompile"
 REFERENCE_TOOL = os.environ.get(
     "HALSDK_REFERENCE_TOOL",

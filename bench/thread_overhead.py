@@ -2,7 +2,7 @@
 """Thread overhead: what a 1 kHz thread and its functions cost in CPU time.
 
 Configuration: 1,000 trivial two-input functions (the Cython test component
-``tests/components/tand2.pyx``, an AND gate) in one thread of period 1 ms.
+``tests/data/components/tand2.pyx``, an AND gate) in one thread of period 1 ms.
 
 Figures printed, for halsdk:
 
@@ -45,7 +45,7 @@ from typing import Callable, Optional
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(HERE)
-TAND2 = os.path.join(REPO, "tests", "components", "tand2.pyx")
+TAND2 = os.path.join(REPO, "tests", "data", "components", "tand2.pyx")
 REFERENCE_HALRUN = "/usr/bin/halrun"
 REFERENCE_TOOL = os.environ.get(
     "HALSDK_REFERENCE_TOOL",

@@ -2,19 +2,16 @@
 
 from __future__ import annotations
 
-import contextlib
 import os
-import signal
-import subprocess
 import sys
-from collections.abc import Iterator
 
 import pytest
+from helpers import data_path
+from helpers.environment import on_halsdk_path
 
 from halsdk.build import build_component
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-COMPONENTS = os.path.join(HERE, "components")
+COMPONENTS = str(data_path("components"))
 TEST_COMPONENTS = ["tand2.pyx", "tcounter.pyx", "tlowpass.pyx", "cscale.c"]
 
 
@@ -45,21 +42,6 @@ def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
         print("\n/dev/shm check: no HAL instance left behind")
 
 
-@contextlib.contextmanager
-def on_halsdk_path(folder: str) -> Iterator[str]:
-    """Put folder first on HALSDK_PATH while the block runs (the loader
-    searches it before the installed components)."""
-    old = os.environ.get("HALSDK_PATH")
-    os.environ["HALSDK_PATH"] = folder + (os.pathsep + old if old else "")
-    try:
-        yield folder
-    finally:
-        if old is None:
-            os.environ.pop("HALSDK_PATH", None)
-        else:
-            os.environ["HALSDK_PATH"] = old
-
-
 @pytest.fixture(scope="session", autouse=True)
 def component_path(tmp_path_factory: pytest.TempPathFactory) -> str:
     """Build the test components (cached by content) into a folder on
@@ -79,21 +61,3 @@ def python_tools_first(monkeypatch: pytest.MonkeyPatch) -> str:
     folder = os.path.dirname(sys.executable)
     monkeypatch.setenv("PATH", folder + os.pathsep + os.environ["PATH"])
     return folder
-
-
-@contextlib.contextmanager
-def ended_at_exit(proc: subprocess.Popen) -> Iterator[subprocess.Popen]:
-    """Kill ``proc`` when the block ends with it still running (a failed
-    assertion must not leave a driver process behind)."""
-    try:
-        yield proc
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
-
-
-def sigterm(proc: subprocess.Popen, timeout: float = 10) -> tuple:
-    """Send SIGTERM and wait for the end: (stdout, stderr)."""
-    proc.send_signal(signal.SIGTERM)
-    return proc.communicate(timeout=timeout)

@@ -11,7 +11,7 @@ being set before each step to a value made from the step and its place;
 the values of all its pins and params after each step are recorded.  The
 function timing pins and params are left out.
 
-Used by tests/test_halcompile_corpus.py on our builds of the ``.comp``
+Used by tests/golden/test_halcompile_corpus.py on our builds of the ``.comp``
 files, and by make_goldens.py on builds of the C the reference's
 halcompile generates for the same files.
 """

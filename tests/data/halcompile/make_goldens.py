@@ -29,7 +29,7 @@ import sys
 import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-COMPS = os.path.join(os.path.dirname(os.path.dirname(HERE)), "comps")
+COMPS = os.path.join(os.path.dirname(HERE), "comps")
 REFERENCE = os.environ.get("HALSDK_REFERENCE") or os.path.join(
     os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(HERE)))),
     "shared", "tools", "reference")
