@@ -5,7 +5,7 @@ A smooth closed 3D curve (a wavy loop with a Z undulation, about 1 m long)
 is cut into 20,000 straight lines of 0.05 mm (``--segments``,
 ``--seg``), programmed at 5 m/min (``--feed``) with blending (``G64 P``,
 ``--tolerance``), and run on a simulated machine (motmod + trivkins +
-homemod + tpmod, motor-pos-cmd looped to motor-pos-fb, tests/helpers/motion_trace.py)
+homemod + tpmod, motor-pos-cmd looped to motor-pos-fb, tests/lib/helpers/motion_trace.py)
 whose 1 kHz servo thread is stepped (deterministic mode).  The thread is
 made with ``timing_every=1``, so the ``.time`` pin of every function is
 measured on every cycle; a ``sampler`` at the end of the thread records
@@ -28,7 +28,7 @@ Printed:
   percentage of the requested feed and of what the limits allow: the time
   a rest-to-rest run of the same curve needs at that feed under the axis
   velocity and acceleration limits (a forward/backward pass over the
-  points; tests/helpers/motion_trace.py ``allowed_time``);
+  points; tests/lib/helpers/motion_trace.py ``allowed_time``);
 * the largest deviation from the programmed lines and whether an axis
   limit was exceeded.
 
@@ -63,7 +63,7 @@ from typing import Optional
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(os.path.dirname(HERE), "tests"))
+sys.path.insert(0, os.path.join(os.path.dirname(HERE), "tests", "lib"))
 from helpers import motion_trace as mt  # noqa: E402
 
 VEL = {"x": 200.0, "y": 200.0, "z": 100.0}

@@ -78,14 +78,16 @@ def _find_file(folder: str, name: str) -> Optional[str]:
 _imported: dict[str, int] = {}     # file -> times imported in this process
 
 
-def _import_file(name: str, path: str) -> ModuleType:
+def _import_file(name: str, path: str,
+                 package: Optional[str] = None) -> ModuleType:
     """Import a component module from a file.
 
     A compiled module is mapped once per file by the dynamic loader, so a
     second load would share the C static variables of the first.  As the
     reference loads a module afresh each time, every load after the first
     maps a private copy of the file: its statics start from their initial
-    values.
+    values.  ``package``: the package the module belongs to (a shipped
+    one), whose siblings it imports relatively.
     """
     n = _imported.get(path, 0)
     _imported[path] = n + 1
@@ -101,6 +103,8 @@ def _import_file(name: str, path: str) -> ModuleType:
         if spec is None or spec.loader is None:
             raise LoadError(f"cannot load component '{name}' from {path}")
         module = importlib.util.module_from_spec(spec)
+        if package is not None:
+            module.__package__ = package
         try:
             spec.loader.exec_module(module)
         except Exception as exc:
@@ -137,7 +141,7 @@ def import_component(name: str) -> ModuleType:
         origin = spec.origin or ""
         if origin.endswith(tuple(importlib.machinery.EXTENSION_SUFFIXES)):
             # compiled: each load gets fresh statics, as from a folder
-            return _import_file(name, origin)
+            return _import_file(name, origin, package)
         try:
             return importlib.import_module(qual)
         except Exception as exc:

@@ -16,7 +16,7 @@ from __future__ import annotations
 from pathlib import Path
 
 #: the tests/ folder
-TESTS = Path(__file__).resolve().parent.parent
+TESTS = Path(__file__).resolve().parents[2]
 #: the root of the checkout
 REPO = TESTS.parent
 #: tests/data/
