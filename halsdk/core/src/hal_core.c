@@ -103,6 +103,24 @@ static int fail_exists(int kind, const char *name, const char *fmt)
                     name, NULL, NULL);
 }
 
+/* the two objects a configuration change names, found with the lock
+   held: 0, or the refusal (locked against configuration, either one
+   missing), in that order */
+static int find_for_config(int kind_a, const char *a, void **found_a,
+                           int kind_b, const char *b, void **found_b,
+                           const char *locked_fmt)
+{
+    *found_a = hal_find(kind_a, a);
+    *found_b = hal_find(kind_b, b);
+    if (hal_map.hdr->lock & HAL_LOCK_CONFIG)
+        return fail_locked(kind_a, a, locked_fmt);
+    if (!*found_a)
+        return fail_not_found(kind_a, a);
+    if (!*found_b)
+        return fail_not_found(kind_b, b);
+    return 0;
+}
+
 
 /* ---------------------------------------------------------------- */
 /* process identity                                                 */
@@ -1042,22 +1060,16 @@ int hal_link(const char *pin_name, const char *sig_name)
     int r = hal_lock();
     if (r)
         return r;
-    hal_pin_t *p = hal_find(K_PIN, pin_name);
-    hal_sig_t *s = hal_find(K_SIG, sig_name);
-    if (hal_map.hdr->lock & HAL_LOCK_CONFIG)
-        r = fail_locked(K_PIN, pin_name, "cannot link '%s': HAL is locked "
+    hal_pin_t *p;
+    hal_sig_t *s;
+    r = find_for_config(K_PIN, pin_name, (void **)&p, K_SIG, sig_name,
+                        (void **)&s, "cannot link '%s': HAL is locked "
                         "against configuration");
-    else if (!p)
-        r = fail_not_found(K_PIN, pin_name);
-    else if (!s)
-        r = fail_not_found(K_SIG, sig_name);
-    else if (p->signal == SHMOFF(s))
-        goto out;           /* already there */
-    else {
-        hal_pin_t *other = conflicting_pin(s, p->dir);
-        r = link_check(p, sig_name, s->type, s->writers, s->bidirs,
-                       other ? other->o.name : NULL);
-    }
+    if (r || p->signal == SHMOFF(s))
+        goto out;           /* refused, or already there */
+    hal_pin_t *other = conflicting_pin(s, p->dir);
+    r = link_check(p, sig_name, s->type, s->writers, s->bidirs,
+                   other ? other->o.name : NULL);
     if (!r)
         link_locked(p, s);
 out:
@@ -1500,16 +1512,14 @@ int hal_addf(const char *funct, const char *thread, int position)
     int r = hal_lock();
     if (r)
         return r;
-    hal_funct_t *f = hal_find(K_FUNCT, funct);
-    hal_thread_t *t = hal_find(K_THREAD, thread);
-    if (hal_map.hdr->lock & HAL_LOCK_CONFIG)
-        r = fail_locked(K_FUNCT, funct, "addf '%s': HAL is locked against "
+    hal_funct_t *f;
+    hal_thread_t *t;
+    r = find_for_config(K_FUNCT, funct, (void **)&f, K_THREAD, thread,
+                        (void **)&t, "addf '%s': HAL is locked against "
                         "configuration");
-    else if (!f)
-        r = fail_not_found(K_FUNCT, funct);
-    else if (!t)
-        r = fail_not_found(K_THREAD, thread);
-    else if (!hal_map.is_host)
+    if (r)
+        goto out;
+    if (!hal_map.is_host)
         r = hal_rule(hal_fail(EPERM, "addf '%s': only the host changes "
                               "threads", funct),
                      HAL_RULE_HOST_ONLY, K_FUNCT, funct, thread, NULL);
