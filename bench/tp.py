@@ -5,8 +5,9 @@ A smooth closed 3D curve (a wavy loop with a Z undulation, about 1 m long)
 is cut into 20,000 straight lines of 0.05 mm (``--segments``,
 ``--seg``), programmed at 5 m/min (``--feed``) with blending (``G64 P``,
 ``--tolerance``), and run on a simulated machine (motmod + trivkins +
-homemod + tpmod, motor-pos-cmd looped to motor-pos-fb, tests/lib/helpers/motion_trace.py)
-whose 1 kHz servo thread is stepped (deterministic mode).  The thread is
+homemod + tpmod, motor-pos-cmd looped to motor-pos-fb,
+tests/lib/helpers/motion_trace.py) whose 1 kHz servo thread is stepped
+(deterministic mode).  The thread is
 made with ``timing_every=1``, so the ``.time`` pin of every function is
 measured on every cycle; a ``sampler`` at the end of the thread records
 them with the positions.

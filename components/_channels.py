@@ -24,7 +24,7 @@ MODPARAMS = {
 
 
 def channels(comp: str, depth: Optional[list],
-             cfg: Optional[list]) -> list[tuple[str, list[int], int]]:
+             cfg: Optional[list]) -> list[tuple[str, list[HalType], int]]:
     """(cfg string, types, depth) of each channel, or ValueError naming
     the channel."""
     cfgs = [s for s in (cfg or []) if s != ""]
@@ -32,7 +32,7 @@ def channels(comp: str, depth: Optional[list],
     if not cfgs:
         raise ValueError(f"{comp}: no channels specified (give "
                          "cfg=STRING[,STRING...])")
-    out = []
+    out: list[tuple[str, list[HalType], int]] = []
     for i, s in enumerate(cfgs):
         if i >= len(depths):
             raise ValueError(f"{comp}.{i}: no depth given for cfg '{s}' "

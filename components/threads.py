@@ -8,10 +8,12 @@ it can be loaded again to make more.
 
 from __future__ import annotations
 
+from typing import Any
+
 from halsdk import Component, Hal
 from halsdk.errors import InvalidError
 
-modparams = {}
+modparams: dict[str, tuple[type, Any, str]] = {}
 for _n in (1, 2, 3):
     modparams[f"name{_n}"] = (str, "", f"name of thread {_n}")
     modparams[f"period{_n}"] = (int, 0, f"period of thread {_n} in ns")
@@ -20,9 +22,9 @@ for _n in (1, 2, 3):
 _comp: Component | None = None
 
 
-def setup(**params: object) -> None:
+def setup(**params: Any) -> None:
     global _comp
-    wanted = []
+    wanted: list[tuple[str, int, bool]] = []
     for n in (1, 2, 3):
         name = params.get(f"name{n}", "")
         period = params.get(f"period{n}", 0)

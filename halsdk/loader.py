@@ -204,10 +204,11 @@ def _convert(comp: str, pname: str, kind: str, raw: Any) -> Any:
                            f"{what}") from None
 
 
-def parse_modparams(name: str, module: ModuleType, args: tuple,
+def parse_modparams(name: str, module: object, args: tuple,
                     kwargs: dict) -> dict:
     """Merge ``key=value`` words and keyword arguments, typed by the
-    module's ``modparams``."""
+    ``modparams`` of ``module`` (a component module, or any object with
+    that attribute)."""
     spec = getattr(module, "modparams", None) or {}
     given: dict[str, Any] = {}
     for word in args:

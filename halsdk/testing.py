@@ -91,8 +91,9 @@ class TestHal(halsdk.Hal):
             setter = target.sets if isinstance(target, halsdk.Signal) \
                 else target.setp
             plan.append((setter, value))
-        out = {n: np.empty(cycles, dtype=_DTYPES[src.type])
-               for n, src in sources}
+        out: dict[str, np.ndarray] = {
+            n: np.empty(cycles, dtype=_DTYPES[src.type])
+            for n, src in sources}
         times = np.empty(cycles, dtype=np.int64)
         for k in range(cycles):
             for setter, value in plan:

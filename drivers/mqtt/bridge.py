@@ -177,11 +177,21 @@ class Bridge:
                 self.items.remove(item)
         return values
 
+    def _component(self) -> Component:
+        """The component made by :meth:`start` (RuntimeError before)."""
+        if self.comp is None:
+            raise RuntimeError(f"{self.cfg.name}: call start() first")
+        return self.comp
+
     def _send(self, topic: str, text: str) -> bool:
         if self.cfg.dryrun:
             self._out(f"{topic} {text}")
-        elif not self.link.publish(topic, text):
-            return False
+        else:
+            if self.link is None:
+                raise RuntimeError(f"{self.cfg.name}: no MQTT link (call "
+                                   "start() first)")
+            if not self.link.publish(topic, text):
+                return False
         self._count("published")
         return True
 
@@ -197,19 +207,21 @@ class Bridge:
                         self.cfg.name)
             self._dropping = True
         self._dropped_seen = dropped
-        self.comp["dropped"] = dropped & U32
+        self._component()["dropped"] = dropped & U32
 
     def _count(self, pin: str) -> None:
-        self.comp[pin] = (self.comp[pin] + 1) & U32
+        comp = self._component()
+        comp[pin] = (comp[pin] + 1) & U32
 
     # -- events from the network thread -------------------------------------
     def _event(self, event: tuple) -> None:
+        comp = self._component()
         kind = event[0]
         where = f"{self.cfg.broker}:{self.cfg.broker_port}"
         if kind == "msg":
             self._message(event[1], event[2])
         elif kind == "up":
-            self.comp["connected"] = True
+            comp["connected"] = True
             if self.ever_up:
                 self._count("reconnects")
             self.ever_up = True
@@ -218,21 +230,22 @@ class Bridge:
             self._next_batch = time.monotonic()
             self._clear_fault(where)
         elif kind == "refused":
-            self.comp["connected"] = False
+            comp["connected"] = False
             self._fault(FAULT_REFUSED, f"broker {where} refused the "
                         f"connection: {event[1]}")
         elif kind == "fail":
-            self.comp["connected"] = False
+            comp["connected"] = False
             self._fault(FAULT_CONNECT, f"cannot connect to {where}: "
                         f"{event[1]}")
         elif kind == "lost":
-            self.comp["connected"] = False
+            comp["connected"] = False
             self._fault(FAULT_LOST, f"connection to {where} lost: "
                         f"{event[1]}")
 
     def _fault(self, code: int, text: str) -> None:
-        self.comp["fault"] = True
-        self.comp["fault-code"] = code
+        comp = self._component()
+        comp["fault"] = True
+        comp["fault-code"] = code
         if text != self.fault_text:
             log.error("%s: %s (retrying)", self.cfg.name, text)
             self.fault_text = text
@@ -243,8 +256,9 @@ class Bridge:
         else:
             log.info("%s: connected to %s", self.cfg.name, where)
         self.fault_text = ""
-        self.comp["fault"] = False
-        self.comp["fault-code"] = FAULT_NONE
+        comp = self._component()
+        comp["fault"] = False
+        comp["fault-code"] = FAULT_NONE
 
     def _message(self, topic: str, raw: bytes) -> None:
         self._count("received")
@@ -258,8 +272,9 @@ class Bridge:
                             "further bad payloads on this topic are only "
                             "counted)", self.cfg.name, topic, exc)
             return
+        comp = self._component()
         for pin, value in updates:
-            self.comp[pin] = value
+            comp[pin] = value
 
     def _decode(self, topic: str, raw: bytes) -> list[tuple[str, Any]]:
         obj = payload.parse(raw)
@@ -296,7 +311,7 @@ class Bridge:
             if self.comp is None:
                 self.start()
             while not self._stop.is_set():
-                comp = self.comp
+                comp = self._component()
                 if not comp.exists:
                     log.info("%s: component removed, stopping",
                              self.cfg.name)

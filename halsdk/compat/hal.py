@@ -165,6 +165,12 @@ class item:  # noqa: N801 - the reference's name
     by :meth:`component.getitem`."""
 
     __slots__ = ("_state", "_name", "_handle", "_is_pin", "_type", "_dir")
+    _state: _State
+    _name: str
+    _handle: Any
+    _is_pin: bool
+    _type: int
+    _dir: int
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         raise TypeError("hal.item objects come from component.getitem()")
@@ -301,6 +307,14 @@ class component:  # noqa: N801 - the reference's name
     :meth:`newparam`, call :meth:`ready`, then read and write them as
     ``comp["name"]`` or ``comp.name``.
     """
+
+    # the attributes of the object itself (_INTERNAL; set with
+    # object.__setattr__): every other attribute name is a pin or param
+    _c_state: _State
+    _c_comp: halsdk.Component
+    _c_name: str
+    _c_prefix: str
+    _c_items: dict[str, item]
 
     def __init__(self, name: str, prefix: Optional[str] = None) -> None:
         object.__setattr__(self, "_c_state", _State())

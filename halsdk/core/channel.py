@@ -21,9 +21,12 @@ import socket
 import stat
 import struct
 import threading
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from halsdk.core import errors
+
+if TYPE_CHECKING:
+    from halsdk.core.instance import Connection
 
 _MAX_REQUEST = 1 << 20
 
@@ -64,7 +67,7 @@ class Server:
     """Serves requests on the host: a daemon thread accepts connections and
     each connection is served by a thread of its own."""
 
-    def __init__(self, conn):
+    def __init__(self, conn: Connection) -> None:
         self.conn = conn
         self.path = socket_path(conn.shm)
         try:
@@ -138,7 +141,7 @@ class Server:
             reply = self._dispatch(line)
             client.sendall(json.dumps(reply).encode() + b"\n")
 
-    def _dispatch(self, line: bytes) -> dict:
+    def _dispatch(self, line: bytes) -> dict[str, Any]:
         try:
             req = json.loads(line)
             op = req["op"]

@@ -61,7 +61,7 @@ class HalError(Exception):
     """
 
     def __init__(self, *args: object, rule: Rule = Rule.NONE,
-                 kind: Optional[str] = None, names: tuple = ()):
+                 kind: Optional[str] = None, names: tuple[str, ...] = ()):
         super().__init__(*args)
         self.rule = Rule(rule)
         self.kind = kind

@@ -13,10 +13,14 @@ import re
 import signal
 import threading
 import time
-from typing import Any, Callable, Optional
+from types import FrameType
+from typing import TYPE_CHECKING, Any, Callable, NoReturn, Optional
 
 from halsdk.core import _core
 from halsdk.core.errors import ExistsError, InstanceError, InvalidError
+
+if TYPE_CHECKING:
+    from halsdk.core.channel import Server
 
 _INSTANCE_NAME = re.compile(r"^[A-Za-z0-9_.-]{1,40}$")
 SHM_DIR = "/dev/shm"
@@ -54,8 +58,8 @@ class Connection:
         self.host = host
         self.users = 0
         self.closers: list[Callable[[], None]] = []
-        self.server = None              # request channel, on the host
-        self.handlers: dict[str, Callable] = {}   # requests it serves
+        self.server: Optional[Server] = None    # request channel, on the host
+        self.handlers: dict[str, Callable[..., Any]] = {}  # requests it serves
         # the host's realtime modules: a halsdk.loader.Registry that the
         # first Hal of the host process makes (the core does not know the
         # loader, the layer above it)
@@ -108,11 +112,11 @@ def connect(instance: Optional[str] = None, create: Optional[bool] = None,
         return conn
 
 
-def _probe_settled(shm: str) -> tuple:
+def _probe_settled(shm: str) -> tuple[Any, ...]:
     """Probe, waiting up to a second for an instance being created."""
     deadline = time.monotonic() + 1.0
     while True:
-        found = _core.probe(shm)
+        found: tuple[Any, ...] = _core.probe(shm)
         if found[0] != "creating" or time.monotonic() > deadline:
             return found
         time.sleep(0.01)
@@ -209,7 +213,7 @@ def _install_sigterm() -> None:
     if threading.current_thread() is not threading.main_thread():
         return
     if signal.getsignal(signal.SIGTERM) is signal.SIG_DFL:
-        def on_term(signum, frame):
+        def on_term(signum: int, frame: Optional[FrameType]) -> NoReturn:
             raise SystemExit(128 + signum)
         signal.signal(signal.SIGTERM, on_term)
 

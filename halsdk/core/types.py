@@ -66,13 +66,15 @@ class Direction(IntEnum):
 
 
 #: type -> the word programs write and ``show`` prints (the core's words)
-TYPE_WORDS = {HalType(t): w for t, w in _core.TYPE_NAMES.items()}
+TYPE_WORDS: dict[HalType, str] = {
+    HalType(t): w for t, w in _core.TYPE_NAMES.items()}
 #: type -> the word of the reference's "value invalid for ..." errors
 VALUE_WORDS = {HalType.BIT: "bit", HalType.FLOAT: "float",
                HalType.S32: "S32", HalType.U32: "U32", HalType.S64: "S64",
                HalType.U64: "U64"}
 #: direction -> the word ``show`` prints (the core's words)
-DIR_WORDS = {Direction(d): w for d, w in _core.DIR_NAMES.items()}
+DIR_WORDS: dict[Direction, str] = {
+    Direction(d): w for d, w in _core.DIR_NAMES.items()}
 #: integer type -> (least, most)
 INT_RANGES = {HalType.S32: (-(1 << 31), (1 << 31) - 1),
               HalType.U32: (0, (1 << 32) - 1),
@@ -126,7 +128,7 @@ def parse_direction(value: Union[str, int], param: bool = False) -> Direction:
             d = None
     allowed = (Direction.RO, Direction.RW) if param else (
         Direction.IN, Direction.OUT, Direction.IO)
-    if d not in allowed:
+    if d is None or d not in allowed:
         what = "param direction (ro, rw)" if param else \
             "pin direction (in, out, io)"
         raise InvalidError(f"{value!r} is not a {what}")

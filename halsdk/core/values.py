@@ -10,7 +10,7 @@ integers, hex floats, the bit words ``1``/``0``/``TRUE``/``FALSE``).
 from __future__ import annotations
 
 import re
-from typing import Any, Union
+from typing import Any, Union, cast
 
 from halsdk.core import _core
 from halsdk.core.errors import InvalidError, Rule
@@ -27,7 +27,7 @@ _HEX_FLOAT = re.compile(r"\s*[-+]?0[xX][0-9a-fA-F]*\.?[0-9a-fA-F]*"
 def c_integer(text: str) -> int:
     """An integer as C's ``strtol(text, &end, 0)`` reads a whole word:
     ``0x`` hex, a leading ``0`` octal, else decimal (ValueError if not)."""
-    return _core.c_integer(text)
+    return cast(int, _core.c_integer(text))
 
 
 def parse_word(htype: int, text: str, *, wrap: bool = True) -> Value:

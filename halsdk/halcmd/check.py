@@ -206,14 +206,14 @@ class CheckRunner(CommandRunner):
         pins = {p.name: p for p in (sig.pins if sig is not None else [])}
         for pin in new_pins:
             pins.setdefault(pin.name, pin)
-        stype = sig.type if sig is not None else (
-            new_pins[0].type if new_pins else None)
-        for pin in new_pins:
-            if pin.type != stype:
-                self._specific = self.loc
-                self.add("error", f"type mismatch: pin '{pin.name}' is "
-                         f"{type_word(pin.type)}, signal '{signame}' "
-                         f"is {type_word(stype)}")
+        if new_pins:
+            stype = sig.type if sig is not None else new_pins[0].type
+            for pin in new_pins:
+                if pin.type != stype:
+                    self._specific = self.loc
+                    self.add("error", f"type mismatch: pin '{pin.name}' is "
+                             f"{type_word(pin.type)}, signal '{signame}' "
+                             f"is {type_word(stype)}")
         outs = sorted(n for n, p in pins.items()
                       if p.direction == Direction.OUT)
         ios = sorted(n for n, p in pins.items()

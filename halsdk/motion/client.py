@@ -27,6 +27,7 @@ from halsdk.errors import HalError, NotFoundError
 from halsdk.hal import Hal
 from halsdk.motion import _channel, screwcomp
 from halsdk.motion.ini import (
+    Plan,
     axis_plan,
     homing_fields,
     joint_plan,
@@ -532,8 +533,12 @@ class Motion:
                                    "motion-command-handler in a running "
                                    "thread?)")
                     else:
-                        self._wait(lambda: ch.try_lock() == 0 and
-                                   (ch.unlock() or True), timeout,
+                        def lockable() -> bool:
+                            if ch.try_lock() != 0:
+                                return False
+                            ch.unlock()
+                            return True
+                        self._wait(lockable, timeout,
                                    f"{cmd.name}: the channel lock (held by "
                                    "another process)")
             except _channel.ChannelError as e:
@@ -946,8 +951,8 @@ class Motion:
         DEFAULT_LINEAR_VELOCITY, MAX_LINEAR_ACCELERATION or
         MAX_ACCELERATION).  Unknown keys raise ValueError before anything
         is sent."""
-        plans = [((j,), joint_plan(j, keys))
-                 for j, keys in enumerate(joints)]
+        plans: list[tuple[tuple[int, ...], Plan]] = [
+            ((j,), joint_plan(j, keys)) for j, keys in enumerate(joints)]
         plans += [((_axis(k),), axis_plan(k, v))
                   for k, v in (axes or {}).items()]
         plans.append(((), traj_plan(traj or {})))

@@ -30,6 +30,7 @@ __all__ = ["read_motion_ini", "MotionConfig", "MotionIniError",
 # A "plan" is the list of Motion calls that send the keys of one section:
 # (method name, positional arguments, keyword arguments); the joint or
 # axis number goes first when Motion.configure makes the call.
+Plan = list[tuple[str, tuple[Any, ...], dict[str, Any]]]
 
 _HOME_FLOATS = {"home": "home", "home_offset": "home_offset",
                 "home_search_vel": "home_search_vel",
@@ -117,10 +118,10 @@ def _lower(keys: Mapping[str, Any]) -> dict:
     return {k.lower(): v for k, v in keys.items()}
 
 
-def _limits_plan(kind: str, k: Mapping[str, Any], where: str) -> list:
+def _limits_plan(kind: str, k: Mapping[str, Any], where: str) -> Plan:
     """Soft limits, velocity, acceleration and jerk of a joint or axis
     (kind): the calls that send the keys present."""
-    plan = []
+    plan: Plan = []
     if "min_limit" in k or "max_limit" in k:
         lo = _num(k, "min_limit", where) if "min_limit" in k else -1e99
         hi = _num(k, "max_limit", where) if "max_limit" in k else 1e99
@@ -131,7 +132,7 @@ def _limits_plan(kind: str, k: Mapping[str, Any], where: str) -> list:
     return plan
 
 
-def joint_plan(j: int, keys: Mapping[str, Any]) -> list:
+def joint_plan(j: int, keys: Mapping[str, Any]) -> Plan:
     """The calls that send the keys of [JOINT_j] (lower or upper case);
     ValueError for an unknown key or a bad value."""
     where = f"[JOINT_{j}]"
@@ -167,7 +168,7 @@ def joint_plan(j: int, keys: Mapping[str, Any]) -> list:
     return plan
 
 
-def axis_plan(letter: Any, keys: Mapping[str, Any]) -> list:
+def axis_plan(letter: Any, keys: Mapping[str, Any]) -> Plan:
     """The calls that send the keys of [AXIS_letter]."""
     where = f"[AXIS_{str(letter).upper()}]"
     k = _lower(keys)
@@ -180,7 +181,7 @@ def axis_plan(letter: Any, keys: Mapping[str, Any]) -> list:
     return _limits_plan("axis", k, where)
 
 
-def traj_plan(keys: Mapping[str, Any]) -> list:
+def traj_plan(keys: Mapping[str, Any]) -> Plan:
     """The calls that send the keys of [TRAJ]."""
     where = "[TRAJ]"
     k = _lower(keys)
@@ -192,7 +193,7 @@ def traj_plan(keys: Mapping[str, Any]) -> list:
     if bad:
         raise ValueError(f"{where}: unknown key(s) "
                          f"{', '.join(b.upper() for b in bad)}")
-    plan = []
+    plan: Plan = []
     for key in ("max_linear_velocity", "max_velocity"):
         if key in k:
             plan.append(("set_vel_limit", (_num(k, key, where),), {}))

@@ -5,7 +5,10 @@ from __future__ import annotations
 
 import signal
 import sys
-from typing import Optional
+from typing import TYPE_CHECKING, Optional
+
+if TYPE_CHECKING:
+    from halsdk.hal import Hal
 
 
 def stop_on_signals() -> list:
@@ -21,7 +24,7 @@ def stop_on_signals() -> list:
     return stop
 
 
-def attach(prog: str) -> Optional[object]:
+def attach(prog: str) -> Optional[Hal]:
     """The running instance ($HALSDK_INSTANCE), or None after printing
     why not."""
     from halsdk import errors

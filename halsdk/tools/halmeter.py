@@ -70,7 +70,8 @@ class Options(NamedTuple):
     small: bool
     kind: Optional[str]          # "pin", "sig" or "param"
     name: Optional[str]
-    count: int                   # -1: forever
+    # the field shadows tuple.count(), which mypy refuses for a NamedTuple
+    count: int  # type: ignore[assignment]  # -1: forever
     period_ms: float
     help: bool
 
@@ -97,7 +98,7 @@ def parse_args(argv: Sequence[str]) -> Options:
             small = True
         elif a == "-g":
             # X Y and an optional WIDTH, all integers
-            nums = []
+            nums: list[int] = []
             while (len(nums) < 3 and i + 1 < len(args)
                    and args[i + 1].lstrip("-").isdigit()):
                 i += 1
@@ -201,7 +202,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
               "halsdk; use the text mode: halmeter -s {pin|sig|param} NAME",
               file=sys.stderr)
         return 1
-    if opts.kind is None:
+    if opts.kind is None or opts.name is None:
         print(f"{PROG}: ERROR: -s option requires a probe type and a "
               "pin/signal/parameter name", file=sys.stderr)
         return 1

@@ -106,3 +106,48 @@ def test_values_come_from_the_compiled_extension():
     numbers = [n.value for n in ast.walk(tree) if isinstance(n, ast.Constant)
                and isinstance(n.value, (int, float))]
     assert numbers == [], "halsdk/motion/protocol.py must not type numbers"
+
+
+DICTS = {"Cmd": "CMD", "Echo": "ECHO", "Mode": "MODE", "TermCond": "TERM",
+         "MotionType": "MOTION_TYPE", "KinsType": "KINS_TYPE",
+         "OrientState": "ORIENT_STATE", "Profile": "PROFILE",
+         "ProbeFlag": "PROBE", "HomeFlag": "HOME_FLAGS",
+         "JointFlag": "JOINT_FLAGS"}
+
+
+def _declared() -> dict[str, list[tuple[str, ast.expr]]]:
+    """The member names written in each enum class of protocol.py (what a
+    type checker sees), with the expression each one is given."""
+    tree = ast.parse(Path(protocol.__file__).read_text(encoding="utf-8"))
+    out = {}
+    for node in tree.body:
+        if isinstance(node, ast.ClassDef):
+            out[node.name] = [
+                (t.id, stmt.value) for stmt in node.body
+                if isinstance(stmt, ast.Assign) for t in stmt.targets
+                if isinstance(t, ast.Name)]
+    return out
+
+
+def test_declared_names_are_exactly_the_header():
+    """The names listed in protocol.py are the header's: none missing,
+    none extra, none twice (both directions, so the members a type
+    checker sees are the members the enum has)."""
+    declared = _declared()
+    assert set(declared) == {c[0] for c in CASES} == set(DICTS)
+    for name, header in CASES:
+        names = [n for n, _ in declared[name]]
+        assert len(names) == len(set(names)), f"{name}: a name twice"
+        missing = set(header) - set(names)
+        extra = set(names) - set(header)
+        assert not missing, f"{name}: not declared in protocol.py: {missing}"
+        assert not extra, f"{name}: not in the header: {extra}"
+
+
+def test_each_declared_member_reads_its_own_name():
+    """NAME = _channel.<DICT>["NAME"]: the value of every member is looked
+    up under its own name in the extension's dict of its group."""
+    for cls, members in _declared().items():
+        for name, value in members:
+            assert ast.unparse(value) == \
+                f"_channel.{DICTS[cls]}[{name!r}]", f"{cls}.{name}"
