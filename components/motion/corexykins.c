@@ -16,8 +16,6 @@ MODULE_LICENSE("GPL");
 MODULE_AUTHOR("halsdk");
 MODULE_DESCRIPTION("CoreXY kinematics");
 
-static int comp_id;
-
 int kinematicsForward(const double *joint, EmcPose *world,
                       const KINEMATICS_FORWARD_FLAGS *fflags,
                       KINEMATICS_INVERSE_FLAGS *iflags)
@@ -54,15 +52,6 @@ int kinematicsInverse(const EmcPose *world, double *joint,
     return 0;
 }
 
-int kinematicsHome(EmcPose *world, double *joint,
-                   KINEMATICS_FORWARD_FLAGS *fflags,
-                   KINEMATICS_INVERSE_FLAGS *iflags)
-{
-    *fflags = 0;
-    *iflags = 0;
-    return kinematicsForward(joint, world, fflags, iflags);
-}
-
 KINEMATICS_TYPE kinematicsType(void)
 {
     return KINEMATICS_BOTH;
@@ -70,21 +59,7 @@ KINEMATICS_TYPE kinematicsType(void)
 
 KINS_NOT_SWITCHABLE
 
-EXPORT_SYMBOL(kinematicsForward);
-EXPORT_SYMBOL(kinematicsInverse);
-EXPORT_SYMBOL(kinematicsHome);
-EXPORT_SYMBOL(kinematicsType);
-
 int rtapi_app_main(void)
 {
-    comp_id = hal_init("corexykins");
-    if (comp_id < 0)
-        return comp_id;
-    hal_ready(comp_id);
-    return 0;
-}
-
-void rtapi_app_exit(void)
-{
-    hal_exit(comp_id);
+    return kins_component_ready("corexykins");
 }

@@ -26,4 +26,10 @@ extern int kins_pose_finite(const EmcPose *p);
    "i"/"inverse" (any case) -> KINEMATICS_*; -1 for anything else */
 extern int kins_parse_type(const char *s);
 
+/* kins_module.c (linked into the modules of halsdk): the module's
+   component, made and made ready by kins_component_ready(), removed at
+   unload */
+extern int kins_comp_id;
+extern int kins_component_ready(const char *name);
+
 #endif

@@ -33,8 +33,6 @@ typedef struct {
 } delta_pins_t;
 
 static delta_pins_t *pins;
-static int comp_id;
-
 /* x and y of the three towers for radius r */
 static void towers(double r, double tx[3], double ty[3])
 {
@@ -148,15 +146,6 @@ int kinematicsForward(const double *joint, EmcPose *world,
     return 0;
 }
 
-int kinematicsHome(EmcPose *world, double *joint,
-                   KINEMATICS_FORWARD_FLAGS *fflags,
-                   KINEMATICS_INVERSE_FLAGS *iflags)
-{
-    *fflags = 0;
-    *iflags = 0;
-    return kinematicsForward(joint, world, fflags, iflags);
-}
-
 KINEMATICS_TYPE kinematicsType(void)
 {
     return KINEMATICS_BOTH;
@@ -164,39 +153,31 @@ KINEMATICS_TYPE kinematicsType(void)
 
 KINS_NOT_SWITCHABLE
 
-EXPORT_SYMBOL(kinematicsForward);
-EXPORT_SYMBOL(kinematicsInverse);
-EXPORT_SYMBOL(kinematicsHome);
-EXPORT_SYMBOL(kinematicsType);
-
 int rtapi_app_main(void)
 {
     int r;
 
-    comp_id = hal_init("lineardeltakins");
-    if (comp_id < 0)
-        return comp_id;
+    kins_comp_id = hal_init("lineardeltakins");
+    if (kins_comp_id < 0)
+        return kins_comp_id;
     pins = hal_malloc(sizeof(*pins));
     if (!pins) {
         rtapi_print_msg(RTAPI_MSG_ERR, "lineardeltakins: out of HAL memory\n");
-        hal_exit(comp_id);
+        hal_exit(kins_comp_id);
         return -ENOMEM;
     }
-    r = hal_pin_float_newf(HAL_IN, &pins->r, comp_id, "lineardeltakins.R");
+    r = hal_pin_float_newf(HAL_IN, &pins->r, kins_comp_id,
+                           "lineardeltakins.R");
     if (!r)
-        r = hal_pin_float_newf(HAL_IN, &pins->l, comp_id, "lineardeltakins.L");
+        r = hal_pin_float_newf(HAL_IN, &pins->l, kins_comp_id,
+                               "lineardeltakins.L");
     if (r) {
-        hal_exit(comp_id);
+        hal_exit(kins_comp_id);
         return r;
     }
     /* a mid-size Kossel */
     *pins->r = 130.25;
     *pins->l = 269.0;
-    hal_ready(comp_id);
+    hal_ready(kins_comp_id);
     return 0;
-}
-
-void rtapi_app_exit(void)
-{
-    hal_exit(comp_id);
 }

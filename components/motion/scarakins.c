@@ -47,7 +47,6 @@ typedef struct {
 } scara_pins_t;
 
 static scara_pins_t *pins;
-static int comp_id;
 static int sel;                 /* selected type: 0 scara, 1, 2 identity */
 
 /* a reach test at full stretch must not fail on the last bit */
@@ -151,15 +150,6 @@ int kinematicsInverse(const EmcPose *world, double *joint,
     }
 }
 
-int kinematicsHome(EmcPose *world, double *joint,
-                   KINEMATICS_FORWARD_FLAGS *fflags,
-                   KINEMATICS_INVERSE_FLAGS *iflags)
-{
-    *fflags = 0;
-    *iflags = 0;
-    return kinematicsForward(joint, world, fflags, iflags);
-}
-
 KINEMATICS_TYPE kinematicsType(void)
 {
     return KINEMATICS_BOTH;
@@ -186,10 +176,6 @@ int kinematicsSwitch(int switchkins_type)
     return 0;
 }
 
-EXPORT_SYMBOL(kinematicsForward);
-EXPORT_SYMBOL(kinematicsInverse);
-EXPORT_SYMBOL(kinematicsHome);
-EXPORT_SYMBOL(kinematicsType);
 EXPORT_SYMBOL(kinematicsSwitchable);
 EXPORT_SYMBOL(kinematicsSwitch);
 
@@ -215,44 +201,39 @@ int rtapi_app_main(void)
     }
     if (identityKinematicsSetup(0, coordinates, &kp))
         return -EINVAL;
-    comp_id = hal_init("scarakins");
-    if (comp_id < 0)
-        return comp_id;
+    kins_comp_id = hal_init("scarakins");
+    if (kins_comp_id < 0)
+        return kins_comp_id;
     pins = hal_malloc(sizeof(*pins));
     if (!pins) {
         rtapi_print_msg(RTAPI_MSG_ERR, "scarakins: out of HAL memory\n");
-        hal_exit(comp_id);
+        hal_exit(kins_comp_id);
         return -ENOMEM;
     }
     for (n = 0; n < 6; n++) {
-        r = hal_pin_float_newf(HAL_IN, &pins->d[n], comp_id,
+        r = hal_pin_float_newf(HAL_IN, &pins->d[n], kins_comp_id,
                                "scarakins.D%d", n + 1);
         if (r)
             goto fail;
         *pins->d[n] = dflt[n];
     }
     for (n = 0; n < 3; n++) {
-        r = hal_pin_bit_newf(HAL_OUT, &pins->is[n], comp_id,
+        r = hal_pin_bit_newf(HAL_OUT, &pins->is[n], kins_comp_id,
                              "kinstype.is-%d", n);
         if (r)
             goto fail;
         *pins->is[n] = n == 0;
     }
-    r = hal_pin_s32_newf(HAL_IO, &pins->fct, comp_id, "userk.fct");
+    r = hal_pin_s32_newf(HAL_IO, &pins->fct, kins_comp_id, "userk.fct");
     if (!r)
-        r = hal_pin_s32_newf(HAL_IO, &pins->ict, comp_id, "userk.ict");
+        r = hal_pin_s32_newf(HAL_IO, &pins->ict, kins_comp_id, "userk.ict");
     if (r)
         goto fail;
     sel = 0;
-    hal_ready(comp_id);
+    hal_ready(kins_comp_id);
     return 0;
 
 fail:
-    hal_exit(comp_id);
+    hal_exit(kins_comp_id);
     return r;
-}
-
-void rtapi_app_exit(void)
-{
-    hal_exit(comp_id);
 }

@@ -25,7 +25,6 @@ static char *kinstype = "1";
 RTAPI_MP_STRING(kinstype, "Kinematics type: 1 identity, b both, "
                 "f forward only, i inverse only");
 
-static int comp_id;
 static KINEMATICS_TYPE ktype = KINEMATICS_IDENTITY;
 
 int kinematicsForward(const double *joint, EmcPose *world,
@@ -42,26 +41,12 @@ int kinematicsInverse(const EmcPose *world, double *joint,
     return identityKinematicsInverse(world, joint, iflags, fflags);
 }
 
-int kinematicsHome(EmcPose *world, double *joint,
-                   KINEMATICS_FORWARD_FLAGS *fflags,
-                   KINEMATICS_INVERSE_FLAGS *iflags)
-{
-    *fflags = 0;
-    *iflags = 0;
-    return kinematicsForward(joint, world, fflags, iflags);
-}
-
 KINEMATICS_TYPE kinematicsType(void)
 {
     return ktype;
 }
 
 KINS_NOT_SWITCHABLE
-
-EXPORT_SYMBOL(kinematicsForward);
-EXPORT_SYMBOL(kinematicsInverse);
-EXPORT_SYMBOL(kinematicsHome);
-EXPORT_SYMBOL(kinematicsType);
 
 int rtapi_app_main(void)
 {
@@ -100,14 +85,5 @@ int rtapi_app_main(void)
                         "trivkins: coordinates=%s repeats a letter; "
                         "kinstype=both lets each of its joints be jogged "
                         "alone\n", coordinates);
-    comp_id = hal_init("trivkins");
-    if (comp_id < 0)
-        return comp_id;
-    hal_ready(comp_id);
-    return 0;
-}
-
-void rtapi_app_exit(void)
-{
-    hal_exit(comp_id);
+    return kins_component_ready("trivkins");
 }
