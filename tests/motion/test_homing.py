@@ -15,10 +15,12 @@ its command exactly, one cycle late.
 from __future__ import annotations
 
 import ctypes as C
+import functools
 import math
 
 import numpy as np
 import pytest
+from helpers.fixtures import factory
 
 import halsdk
 from halsdk.core import _core
@@ -265,15 +267,9 @@ class Rig:
 
 @pytest.fixture
 def rig(hal):
-    made = []
-
-    def make(*args, **kw):
-        r = Rig(hal, *args, **kw)
-        made.append(r)
-        return r
-    yield make
-    for r in made:
-        _core.comp_exit(r.cid)
+    with factory(functools.partial(Rig, hal),
+                 lambda r: _core.comp_exit(r.cid)) as make:
+        yield make
 
 
 def physical(r, k, pos):
