@@ -61,6 +61,7 @@ import time
 from typing import Optional
 
 import numpy as np
+from benchlib import add_repeat
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(os.path.dirname(HERE), "tests", "lib"))
@@ -261,8 +262,7 @@ def main(argv: Optional[list[str]] = None) -> int:
     p.add_argument("--feed", type=float, default=5000, help="mm/min")
     p.add_argument("--tolerance", type=float, default=0.01,
                    help="G64 P, mm")
-    p.add_argument("--repeat", type=int, default=3,
-                   help="identical runs; per cycle the minimum is kept")
+    add_repeat(p, 3, "identical runs; per cycle the minimum is kept")
     p.add_argument("--prequeue", action="store_true",
                    help="queue everything while paused, then resume")
     p.add_argument("--no-planner", action="store_true",
@@ -270,7 +270,7 @@ def main(argv: Optional[list[str]] = None) -> int:
     a = p.parse_args(argv)
     feed = a.feed / 60
     r = run(a.segments, a.seg, feed, a.tolerance, a.prequeue,
-            not a.no_planner, max(1, a.repeat))
+            not a.no_planner, a.repeat)
     print(f"\ncoordinated planner: {a.segments} lines of {a.seg:g} mm "
           f"(3D, {r['length']:.1f} mm), F{a.feed:g} mm/min, "
           f"G64 P{a.tolerance:g}, 1 kHz servo thread stepped")
