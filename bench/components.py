@@ -43,9 +43,7 @@ Run: ``python bench/components.py [--seconds 3] [--repeat 1]
 from __future__ import annotations
 
 import argparse
-import fcntl
 import os
-import shutil
 import statistics
 import subprocess
 import sys
@@ -55,9 +53,17 @@ from dataclasses import dataclass
 from typing import Optional
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from thread_overhead import (  # noqa: E402
+from benchlib import (  # noqa: E402
     REFERENCE_HALRUN,
     REFERENCE_TOOL,
+    add_no_reference,
+    add_repeat,
+    reference_lock,
+    run_folder,
+    session,
+    use_reference,
+)
+from thread_overhead import (  # noqa: E402
     our_rtapi_app,
     process_cpu,
     rtapi_apps,
@@ -157,55 +163,41 @@ def run_once(case: Case, loaded: bool, seconds: float, warmup: float,
     """Run the case's HAL file and sample the process that runs its
     threads for ``seconds``, after ``warmup``."""
     hold = f"{warmup + seconds + 1:.0f}.{os.getpid() % 100000:05d}"
-    folder = tempfile.mkdtemp(prefix="halsdk-bench-comp-")
-    os.chmod(folder, 0o755)
     env = dict(os.environ)
     if not reference:
         env["HALSDK_INSTANCE"] = f"benchcomp-{os.getpid()}"
-    try:
-        path = os.path.join(folder, "bench.hal")
-        with open(path, "w") as f:
-            f.write(hal_text(case, loaded, hold))
-        os.chmod(path, 0o644)
-        log = tempfile.TemporaryFile("w+")
-        cmd = ([REFERENCE_TOOL, "halrun", "-f", "bench.hal"] if reference
-               else ours_command())
-        proc = subprocess.Popen(cmd, cwd=folder, stdin=subprocess.DEVNULL,
-                                stdout=log, stderr=subprocess.STDOUT,
-                                start_new_session=True, env=env)
-        try:
-            deadline = time.monotonic() + 120
-            while True:
-                host = our_rtapi_app(hold) if reference else \
-                    (proc.pid if _sleeping_child(proc.pid, hold) else None)
-                if host:
-                    break
-                if proc.poll() is not None or time.monotonic() > deadline:
-                    log.seek(0)
-                    raise RuntimeError(f"{case.name}: run failed:\n"
-                                       + log.read()[-2000:])
-                time.sleep(0.02)
-            time.sleep(warmup)
-            t0, c0 = time.monotonic(), process_cpu(host)
-            time.sleep(seconds)
-            t1, c1 = time.monotonic(), process_cpu(host)
-            cycles = (t1 - t0) * 1e9 / case.period
-            proc.wait(timeout=warmup + seconds + 60)
-            log.seek(0)
-            values = [int(x) for x in log.read().split() if x.isdigit()]
-            if reference:
-                mhz = tsc_mhz() or 1000.0
-                values = [v * 1000 / mhz for v in values]
-            if proc.returncode != 0 or len(values) < READS // 2:
-                raise RuntimeError(f"{case.name}: unexpected output")
-            return Result((c1 - c0) * 1e9 / cycles, statistics.median(values))
-        finally:
-            if proc.poll() is None:
-                os.killpg(proc.pid, 15)
-                proc.wait(timeout=10)
-            log.close()
-    finally:
-        shutil.rmtree(folder, ignore_errors=True)
+    cmd = ([REFERENCE_TOOL, "halrun", "-f", "bench.hal"] if reference
+           else ours_command())
+    with run_folder("halsdk-bench-comp-",
+                    {"bench.hal": hal_text(case, loaded, hold)}) as folder, \
+            tempfile.TemporaryFile("w+") as log, \
+            session(cmd, cwd=folder, stdout=log, stderr=subprocess.STDOUT,
+                    env=env) as proc:
+        deadline = time.monotonic() + 120
+        while True:
+            host = our_rtapi_app(hold) if reference else \
+                (proc.pid if _sleeping_child(proc.pid, hold) else None)
+            if host:
+                break
+            if proc.poll() is not None or time.monotonic() > deadline:
+                log.seek(0)
+                raise RuntimeError(f"{case.name}: run failed:\n"
+                                   + log.read()[-2000:])
+            time.sleep(0.02)
+        time.sleep(warmup)
+        t0, c0 = time.monotonic(), process_cpu(host)
+        time.sleep(seconds)
+        t1, c1 = time.monotonic(), process_cpu(host)
+        cycles = (t1 - t0) * 1e9 / case.period
+        proc.wait(timeout=warmup + seconds + 60)
+        log.seek(0)
+        values = [int(x) for x in log.read().split() if x.isdigit()]
+        if reference:
+            mhz = tsc_mhz() or 1000.0
+            values = [v * 1000 / mhz for v in values]
+        if proc.returncode != 0 or len(values) < READS // 2:
+            raise RuntimeError(f"{case.name}: unexpected output")
+        return Result((c1 - c0) * 1e9 / cycles, statistics.median(values))
 
 
 def _sleeping_child(pid: int, hold: str) -> bool:
@@ -219,8 +211,7 @@ def _run_locked(case: Case, loaded: bool, seconds: float, warmup: float,
                 reference: bool) -> Result:
     if not reference:
         return run_once(case, loaded, seconds, warmup, False)
-    with open(LOCK, "a") as lock:
-        fcntl.flock(lock, fcntl.LOCK_EX)
+    with reference_lock():
         _wait_for_reference()
         return run_once(case, loaded, seconds, warmup, True)
 
@@ -244,11 +235,6 @@ def _wait_for_reference() -> None:
         time.sleep(0.5)
 
 
-#: one reference HAL at a time on a machine: the lock tests/data/complib's
-#: golden.py takes too
-LOCK = "/tmp/halsdk-reference.lock"
-
-
 def fmt(v: Optional[float]) -> str:
     return "-" if v is None else f"{v:.1f}"
 
@@ -262,12 +248,11 @@ def main(argv: Optional[list[str]] = None) -> int:
     p.add_argument("--seconds", type=float, default=3.0,
                    help="length of each CPU measurement (default 3)")
     p.add_argument("--warmup", type=float, default=0.5)
-    p.add_argument("--repeat", type=int, default=1,
-                   help="median of this many runs (default 1)")
+    add_repeat(p, 1, "median of this many runs")
     p.add_argument("--cases", default="",
                    help="comma-separated subset of: pid, stepgen, "
                         "encoder, siggen, limit3")
-    p.add_argument("--no-reference", action="store_true")
+    add_no_reference(p)
     p.add_argument("--cpu", action="store_true",
                    help="also print the CPU-time figures (with 16 calls "
                         "per cycle they drown in the wake-up cost; see "
@@ -275,10 +260,9 @@ def main(argv: Optional[list[str]] = None) -> int:
     a = p.parse_args(argv)
     chosen = [c for c in cases()
               if not a.cases or c.name in a.cases.split(",")]
-    if not chosen or a.seconds <= 0 or a.repeat < 1:
+    if not chosen or a.seconds <= 0:
         p.error("nothing to run")
-    with_ref = (not a.no_reference and os.path.exists(REFERENCE_HALRUN)
-                and os.access(REFERENCE_TOOL, os.X_OK))
+    with_ref = use_reference(not a.no_reference, REFERENCE_HALRUN)
     rows = []
     for case in chosen:
         ours = measure(case, a.seconds, a.warmup, a.repeat, False)

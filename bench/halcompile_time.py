@@ -38,20 +38,24 @@ import argparse
 import os
 import shutil
 import statistics
-import subprocess
 import sys
 import tempfile
-import time
 from collections.abc import Callable, Sequence
 from typing import Optional
+
+from benchlib import (
+    REFERENCE_HALCOMPILE,
+    REFERENCE_TOOL,
+    add_keep,
+    add_no_reference,
+    add_repeat,
+    timed,
+    use_reference,
+)
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(HERE)
 COMPS = os.path.join(REPO, "tests", "data", "comps")
-REFERENCE_HALCOMPILE = "/usr/bin/halcompile"
-REFERENCE_TOOL = os.environ.get(
-    "HALSDK_REFERENCE_TOOL",
-    os.path.join(os.path.dirname(REPO), "shared", "tools", "reference"))
 OURS = [sys.executable, "-m", "halcompile.cli", "--compile"]
 
 
@@ -93,19 +97,6 @@ def _one_file(parent: str, src: str, name: str = "") -> str:
     return dest
 
 
-def _timed(cmd: Sequence[str], cwd: str,
-           env: Optional[dict[str, str]] = None) -> float:
-    t0 = time.perf_counter()
-    proc = subprocess.run(list(cmd), cwd=cwd, env=env,
-                          stdin=subprocess.DEVNULL, capture_output=True,
-                          text=True)
-    wall = time.perf_counter() - t0
-    if proc.returncode != 0:
-        raise RuntimeError(f"{' '.join(cmd)} failed in {cwd}:\n"
-                           f"{proc.stdout}{proc.stderr}")
-    return wall
-
-
 def _ours_env(cache: str) -> dict[str, str]:
     env = dict(os.environ)
     env["HALSDK_CACHE"] = cache
@@ -119,8 +110,8 @@ def time_ours(path: str, work: str) -> tuple[float, float]:
     folder = os.path.dirname(src)
     cache = tempfile.mkdtemp(prefix="cache-", dir=work)
     env = _ours_env(cache)
-    cold = _timed(OURS + [os.path.basename(src)], folder, env)
-    cached = _timed(OURS + [os.path.basename(src)], folder, env)
+    cold = timed(OURS + [os.path.basename(src)], folder, env)[0]
+    cached = timed(OURS + [os.path.basename(src)], folder, env)[0]
     shutil.rmtree(cache, ignore_errors=True)
     shutil.rmtree(folder, ignore_errors=True)
     return cold, cached
@@ -130,8 +121,8 @@ def time_reference(path: str, work: str) -> float:
     src = _one_file(work, path)
     folder = os.path.dirname(src)
     try:
-        return _timed([REFERENCE_TOOL, "halcompile", "--compile",
-                       os.path.basename(src)], folder)
+        return timed([REFERENCE_TOOL, "halcompile", "--compile",
+                      os.path.basename(src)], folder)[0]
     finally:
         shutil.rmtree(folder, ignore_errors=True)
 
@@ -142,7 +133,7 @@ def time_wrapper(path: str, work: str) -> float:
     src = _one_file(work, path)
     folder = os.path.dirname(src)
     try:
-        return _timed([REFERENCE_TOOL, "true"], folder)
+        return timed([REFERENCE_TOOL, "true"], folder)[0]
     finally:
         shutil.rmtree(folder, ignore_errors=True)
 
@@ -158,21 +149,15 @@ def _fmt(walls: list[float]) -> str:
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    p.add_argument("--repeat", type=int, default=3,
-                   help="runs per figure (median)")
+    add_repeat(p, 3, "runs per figure (median)")
     p.add_argument("--pins", type=int, default=200,
                    help="pin pairs of the generated large file")
     p.add_argument("--functions", type=int, default=40,
                    help="functions of the generated large file")
-    p.add_argument("--no-reference", action="store_true",
-                   help="do not run the LinuxCNC reference")
-    p.add_argument("--keep", help="also write the generated file here")
+    add_no_reference(p)
+    add_keep(p)
     a = p.parse_args(argv)
-    use_ref = not a.no_reference and os.path.exists(REFERENCE_HALCOMPILE)
-    if use_ref and not os.path.exists(REFERENCE_TOOL):
-        print(f"reference tool {REFERENCE_TOOL} not found; skipping the "
-              "reference", file=sys.stderr)
-        use_ref = False
+    use_ref = use_reference(not a.no_reference, REFERENCE_HALCOMPILE)
     with tempfile.TemporaryDirectory(prefix="halcompile-bench-") as work:
         big = os.path.join(work, "hcbig.comp")
         text = generate(a.pins, a.functions)

@@ -38,21 +38,24 @@ from __future__ import annotations
 
 import argparse
 import os
-import shutil
 import statistics
-import subprocess
 import sys
-import tempfile
 import time
 from collections.abc import Sequence
 from typing import Optional
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-REPO = os.path.dirname(HERE)
-REFERENCE_HALRUN = "/usr/bin/halrun"
-REFERENCE_TOOL = os.environ.get(
-    "HALSDK_REFERENCE_TOOL",
-    os.path.join(os.path.dirname(REPO), "shared", "tools", "reference"))
+from benchlib import (
+    REFERENCE_HALRUN,
+    REFERENCE_TOOL,
+    RunError,
+    add_keep,
+    add_no_reference,
+    add_repeat,
+    run_folder,
+    timed,
+    use_reference,
+)
+
 OURS = [sys.executable, "-m", "halsdk.halcmd.cli", "halrun"]
 BUSY = "Realtime already running"
 GATES = ("and2", "or2", "xor2", "not")
@@ -101,26 +104,9 @@ def generate(lines: int = 10_000, instances: int = INSTANCES) -> str:
 
 # ------------------------------------------------------------ timing
 
-class RunError(RuntimeError):
-    pass
-
-
-def _timed(cmd: Sequence[str], folder: str) -> tuple[float, str]:
-    """Run ``cmd`` in ``folder``; (wall time in s, stdout + stderr)."""
-    t0 = time.perf_counter()
-    proc = subprocess.run(list(cmd), cwd=folder, stdin=subprocess.DEVNULL,
-                          capture_output=True, text=True, timeout=600)
-    wall = time.perf_counter() - t0
-    out = proc.stdout + proc.stderr
-    if proc.returncode != 0:
-        raise RunError(f"{' '.join(cmd)} exited with {proc.returncode}:\n"
-                       + out[-2000:])
-    return wall, proc.stdout
-
-
 def time_ours(path: str) -> tuple[float, str]:
     folder = os.path.dirname(path)
-    return _timed(OURS + ["-f", os.path.basename(path)], folder)
+    return timed(OURS + ["-f", os.path.basename(path)], folder)
 
 
 def time_reference(path: str, retry_s: float = 300) -> tuple[float, str]:
@@ -130,7 +116,7 @@ def time_reference(path: str, retry_s: float = 300) -> tuple[float, str]:
     deadline = time.monotonic() + retry_s
     while True:
         try:
-            return _timed([REFERENCE_TOOL, "halrun", "-f",
+            return timed([REFERENCE_TOOL, "halrun", "-f",
                            os.path.basename(path)], folder)
         except RunError as e:
             if BUSY not in str(e) or time.monotonic() > deadline:
@@ -141,7 +127,7 @@ def time_reference(path: str, retry_s: float = 300) -> tuple[float, str]:
 def time_wrapper(path: str) -> float:
     """The reference tool's own cost: ``reference true`` from a folder
     holding the same file (the tool copies the folder)."""
-    return _timed([REFERENCE_TOOL, "true"], os.path.dirname(path))[0]
+    return timed([REFERENCE_TOOL, "true"], os.path.dirname(path))[0]
 
 
 def measure(fn, repeat: int) -> tuple[list[float], str]:
@@ -157,15 +143,6 @@ def _fmt(walls: list[float]) -> str:
     return f"{med:8.3f} s  ({min(walls):.3f}..{max(walls):.3f})"
 
 
-def _one_file(name: str, text: str) -> str:
-    """Write ``text`` as ``name`` in a new temp folder of its own."""
-    folder = tempfile.mkdtemp(prefix="halsdk-bench-load-")
-    path = os.path.join(folder, name)
-    with open(path, "w") as f:
-        f.write(text)
-    return path
-
-
 def main(argv: Optional[Sequence[str]] = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--lines", type=int, default=10_000,
@@ -174,15 +151,10 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
                    help="gates of each of the 4 kinds (default "
                         f"{INSTANCES}; the reference's HAL memory holds "
                         "about 1,300 gates)")
-    p.add_argument("--repeat", type=int, default=3,
-                   help="runs of each case; the median is printed")
-    p.add_argument("--no-reference", action="store_true",
-                   help="do not run the LinuxCNC reference")
-    p.add_argument("--keep", metavar="FILE",
-                   help="also write the generated file to FILE")
+    add_repeat(p, 3, "runs of each case; the median is printed")
+    add_no_reference(p)
+    add_keep(p)
     a = p.parse_args(argv)
-    if a.repeat < 1:
-        p.error("--repeat must be at least 1")
     try:
         text = generate(a.lines, a.instances)
     except ValueError as e:
@@ -190,14 +162,11 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     if a.keep:
         with open(a.keep, "w") as f:
             f.write(text)
-    big = _one_file("load.hal", text)
-    empty = _one_file("empty.hal", "")
-    use_ref = not a.no_reference and os.path.exists(REFERENCE_HALRUN)
-    if use_ref and not os.path.exists(REFERENCE_TOOL):
-        print(f"reference tool {REFERENCE_TOOL} not found; skipping the "
-              "reference", file=sys.stderr)
-        use_ref = False
-    try:
+    use_ref = use_reference(not a.no_reference, REFERENCE_HALRUN)
+    with run_folder("halsdk-bench-load-", {"load.hal": text}) as big_dir, \
+            run_folder("halsdk-bench-load-", {"empty.hal": ""}) as empty_dir:
+        big = os.path.join(big_dir, "load.hal")
+        empty = os.path.join(empty_dir, "empty.hal")
         print(f"file: {a.lines} lines ({len(GATES)} gate kinds x "
               f"{a.instances} instances); "
               f"{a.repeat} run(s) per case, median (min..max)")
@@ -240,9 +209,6 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
                   f"from the reference: {med['ours'] / net_big:.2f} and "
                   f"{med['ours empty'] / net_empty:.2f})")
         return 0
-    finally:
-        for path in (big, empty):
-            shutil.rmtree(os.path.dirname(path), ignore_errors=True)
 
 
 if __name__ == "__main__":

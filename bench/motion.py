@@ -29,21 +29,25 @@ Run: ``python bench/motion.py [--joints 3,9] [--no-reference]``.
 from __future__ import annotations
 
 import argparse
-import fcntl
 import os
-import shutil
 import statistics
 import subprocess
 import sys
-import tempfile
 import time
 from typing import Optional
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from thread_overhead import REFERENCE_HALRUN, REFERENCE_TOOL, tsc_mhz  # noqa: E402
+from benchlib import (  # noqa: E402
+    REFERENCE_HALRUN,
+    REFERENCE_TOOL,
+    add_no_reference,
+    reference_lock,
+    run_folder,
+    use_reference,
+)
+from thread_overhead import tsc_mhz  # noqa: E402
 
 READS = 60
-LOCK = "/tmp/halsdk-reference.lock"
 FUNCTIONS = ("motion-command-handler", "motion-controller")
 
 
@@ -63,15 +67,9 @@ def reference_idle(joints: int) -> Optional[float]:
         lines += ["loadusr -w sleep 0.05"]
         lines += [f"getp {f}.time" for f in FUNCTIONS]
     lines += ["stop", ""]
-    folder = tempfile.mkdtemp(prefix="halsdk-bench-motion-")
-    os.chmod(folder, 0o755)
-    try:
-        path = os.path.join(folder, "bench.hal")
-        with open(path, "w") as f:
-            f.write("\n".join(lines))
-        os.chmod(path, 0o644)
-        with open(LOCK, "a") as lock:
-            fcntl.flock(lock, fcntl.LOCK_EX)
+    with run_folder("halsdk-bench-motion-",
+                    {"bench.hal": "\n".join(lines)}) as folder:
+        with reference_lock():
             # the system PATH: a halsdk venv first on PATH would give the
             # reference's user our halrun
             env = dict(os.environ, PATH="/usr/sbin:/usr/bin:/sbin:/bin")
@@ -89,8 +87,6 @@ def reference_idle(joints: int) -> Optional[float]:
         cycles = [(a + b) * 1000 / mhz
                   for a, b in zip(values[0::2], values[1::2])]
         return statistics.median(cycles)
-    finally:
-        shutil.rmtree(folder, ignore_errors=True)
 
 
 def ours(joints: int, jog: Optional[str]) -> float:
@@ -128,11 +124,10 @@ def ours(joints: int, jog: Optional[str]) -> float:
 def main(argv: Optional[list[str]] = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--joints", default="3,9")
-    p.add_argument("--no-reference", action="store_true")
+    add_no_reference(p)
     a = p.parse_args(argv)
     counts = [int(x) for x in a.joints.split(",") if x]
-    with_ref = (not a.no_reference and os.path.exists(REFERENCE_HALRUN)
-                and os.access(REFERENCE_TOOL, os.X_OK))
+    with_ref = use_reference(not a.no_reference, REFERENCE_HALRUN)
     print("\nmotion-command-handler + motion-controller, ns per 1 kHz "
           "cycle (median of 60 reads)\n")
     rows = [("joints", "case", "ours", "reference", "ratio")]

@@ -21,13 +21,16 @@ import tempfile
 import time
 from pathlib import Path
 
+from benchlib import (
+    LOCK,
+    REFERENCE_MB2HAL,
+    REFERENCE_TOOL,
+    run_folder,
+    session,
+    use_reference,
+)
+
 ROOT = Path(__file__).resolve().parents[1]
-REFERENCE_MB2HAL = "/usr/bin/mb2hal"
-REFERENCE_TOOL = os.environ.get(
-    "HALSDK_REFERENCE_TOOL",
-    str(ROOT.parent / "shared" / "tools" / "reference"))
-#: one reference HAL at a time on a machine (the tests' lock too)
-LOCK = "/tmp/halsdk-reference.lock"
 
 INI = """[MB2HAL_INIT]
 INIT_DEBUG=0
@@ -111,32 +114,24 @@ def _program_rate(reference: bool, seconds: float) -> float:
         count[0] += 1
 
     server = sim.ServerThread(on_request=on_request).start()
-    folder = tempfile.mkdtemp(prefix="halsdk-bench-mb-")
-    os.chmod(folder, 0o755)
+    hal = ("loadusr -Wn mbbench mb2hal config=bench.ini\n"
+           f"loadusr -w sleep {seconds + 3:.1f}\n")
+    env = dict(os.environ)
+    if reference:
+        env["PATH"] = "/usr/sbin:/usr/bin:/sbin:/bin"
+        cmd = ["flock", LOCK, "timeout", "120", REFERENCE_TOOL,
+               "halrun", "-f", "bench.hal"]
+    else:
+        bindir = os.path.dirname(sys.executable)
+        env["PATH"] = bindir + os.pathsep + env.get("PATH", "")
+        env["HALSDK_INSTANCE"] = f"mbbench-{os.getpid()}"
+        cmd = [os.path.join(bindir, "halrun"), "-f", "bench.hal"]
     try:
-        ini = Path(folder) / "bench.ini"
-        ini.write_text(INI.format(port=server.port))
-        hal = Path(folder) / "bench.hal"
-        hal.write_text("loadusr -Wn mbbench mb2hal config=bench.ini\n"
-                       f"loadusr -w sleep {seconds + 3:.1f}\n")
-        for f in (ini, hal):
-            os.chmod(f, 0o644)
-        env = dict(os.environ)
-        if reference:
-            env["PATH"] = "/usr/sbin:/usr/bin:/sbin:/bin"
-            cmd = ["flock", LOCK, "timeout", "120", REFERENCE_TOOL,
-                   "halrun", "-f", "bench.hal"]
-        else:
-            bindir = os.path.dirname(sys.executable)
-            env["PATH"] = bindir + os.pathsep + env.get("PATH", "")
-            env["HALSDK_INSTANCE"] = f"mbbench-{os.getpid()}"
-            cmd = [os.path.join(bindir, "halrun"), "-f", "bench.hal"]
-        proc = subprocess.Popen(cmd, cwd=folder, env=env,
-                                stdin=subprocess.DEVNULL,
-                                stdout=subprocess.DEVNULL,
-                                stderr=subprocess.DEVNULL,
-                                start_new_session=True)
-        try:
+        with run_folder("halsdk-bench-mb-",
+                        {"bench.ini": INI.format(port=server.port),
+                         "bench.hal": hal}) as folder, \
+                session(cmd, cwd=folder, env=env, stdout=subprocess.DEVNULL,
+                        stderr=subprocess.DEVNULL) as proc:
             deadline = time.monotonic() + 60
             while count[0] == 0:
                 if proc.poll() is not None or time.monotonic() > deadline:
@@ -147,15 +142,8 @@ def _program_rate(reference: bool, seconds: float) -> float:
             time.sleep(seconds)
             n1, t1 = count[0], time.monotonic()
             proc.wait(timeout=seconds + 60)
-        finally:
-            if proc.poll() is None:
-                os.killpg(proc.pid, 15)
-                proc.wait(timeout=10)
     finally:
         server.stop()
-        for name in os.listdir(folder):
-            os.unlink(os.path.join(folder, name))
-        os.rmdir(folder)
     return (n1 - n0) / (t1 - t0)
 
 
@@ -163,8 +151,7 @@ def compare(seconds: float = 3.0, reference: bool = True) -> dict:
     """Ours and the reference's mb2hal program, side by side."""
     ours = _program_rate(False, seconds)
     ref = None
-    if reference and os.path.exists(REFERENCE_MB2HAL) and \
-            os.access(REFERENCE_TOOL, os.X_OK):
+    if use_reference(reference, REFERENCE_MB2HAL):
         ref = _program_rate(True, seconds)
     print(f"mb2hal program under halrun, requests/s at the server: "
           f"ours {ours:.0f}, reference "

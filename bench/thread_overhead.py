@@ -43,13 +43,19 @@ import time
 from dataclasses import dataclass, field
 from typing import Callable, Optional
 
+from benchlib import (
+    REFERENCE_HALRUN,
+    REFERENCE_TOOL,
+    add_no_reference,
+    add_repeat,
+    run_folder,
+    session,
+    use_reference,
+)
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(HERE)
 TAND2 = os.path.join(REPO, "tests", "data", "components", "tand2.pyx")
-REFERENCE_HALRUN = "/usr/bin/halrun"
-REFERENCE_TOOL = os.environ.get(
-    "HALSDK_REFERENCE_TOOL",
-    os.path.join(os.path.dirname(REPO), "shared", "tools", "reference"))
 PERIOD_NS = 1_000_000
 CLK_TCK = os.sysconf("SC_CLK_TCK")
 
@@ -276,45 +282,34 @@ def reference_once(n: int, seconds: float,
     # the thread's time of its last cycle (CPU clocks), read a few times
     lines += ["loadusr -w sleep 0.05", "getp servo.time"] * 10
     lines += ["stop", ""]
-    folder = tempfile.mkdtemp(prefix="halsdk-bench-ref-")
-    try:
-        with open(os.path.join(folder, "bench.hal"), "w") as f:
-            f.write("\n".join(lines))
-        log = tempfile.TemporaryFile("w+")
-        proc = subprocess.Popen(
-            [REFERENCE_TOOL, "halrun", "-f", "bench.hal"], cwd=folder,
-            stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT,
-            start_new_session=True)
-        try:
-            deadline = time.monotonic() + 120
-            while not our_rtapi_app(hold):
-                if proc.poll() is not None or time.monotonic() > deadline:
-                    log.seek(0)
-                    raise RuntimeError("reference run failed:\n"
-                                       + log.read()[-2000:])
-                time.sleep(0.05)
-            rt = our_rtapi_app(hold)
-            time.sleep(warmup)
-            t0 = time.monotonic()
-            s = sample(rt, seconds, lambda: 0)
-            wall = time.monotonic() - t0
-            alone = rtapi_apps() == {rt}
-            # the reference does not show a cycle count: it is the elapsed
-            # time over the period (it does not overrun at this load)
-            s.cycles = round(wall * 1e9 / PERIOD_NS)
-            proc.wait(timeout=warmup + seconds + 60)
-            log.seek(0)
-            mhz = tsc_mhz()
-            s.in_cycle_ns = [int(x) * 1000 / mhz for x in log.read().split()
-                             if x.isdigit()] if mhz else []
-            return s, alone and proc.returncode == 0
-        finally:
-            if proc.poll() is None:
-                os.killpg(proc.pid, 15)
-                proc.wait(timeout=10)
-            log.close()
-    finally:
-        shutil.rmtree(folder, ignore_errors=True)
+    with run_folder("halsdk-bench-ref-",
+                    {"bench.hal": "\n".join(lines)}) as folder, \
+            tempfile.TemporaryFile("w+") as log, \
+            session([REFERENCE_TOOL, "halrun", "-f", "bench.hal"],
+                    cwd=folder, stdout=log,
+                    stderr=subprocess.STDOUT) as proc:
+        deadline = time.monotonic() + 120
+        while not our_rtapi_app(hold):
+            if proc.poll() is not None or time.monotonic() > deadline:
+                log.seek(0)
+                raise RuntimeError("reference run failed:\n"
+                                   + log.read()[-2000:])
+            time.sleep(0.05)
+        rt = our_rtapi_app(hold)
+        time.sleep(warmup)
+        t0 = time.monotonic()
+        s = sample(rt, seconds, lambda: 0)
+        wall = time.monotonic() - t0
+        alone = rtapi_apps() == {rt}
+        # the reference does not show a cycle count: it is the elapsed
+        # time over the period (it does not overrun at this load)
+        s.cycles = round(wall * 1e9 / PERIOD_NS)
+        proc.wait(timeout=warmup + seconds + 60)
+        log.seek(0)
+        mhz = tsc_mhz()
+        s.in_cycle_ns = [int(x) * 1000 / mhz for x in log.read().split()
+                         if x.isdigit()] if mhz else []
+        return s, alone and proc.returncode == 0
 
 
 # ------------------------------------------------------------ report
@@ -416,34 +411,27 @@ def main(argv: Optional[list[str]] = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--seconds", type=float, default=3.0,
                    help="length of each measurement (default 3)")
-    p.add_argument("--repeat", type=int, default=1,
-                   help="measure each figure this many times and print "
-                        "the median (default 1)")
+    add_repeat(p, 1, "measure each figure this many times and print the "
+                     "median")
     p.add_argument("--warmup", type=float, default=0.5,
                    help="run time before each measurement (default 0.5)")
     p.add_argument("--count", type=int, default=1000,
                    help="number of functions (default 1000)")
-    p.add_argument("--no-reference", action="store_true",
-                   help="do not run the LinuxCNC reference")
+    add_no_reference(p)
     p.add_argument("--non-realtime", action="store_true",
                    help="start our thread with normal scheduling, as the "
                         "reference runs when not setuid root")
     a = p.parse_args(argv)
-    if a.seconds <= 0 or a.count < 1 or a.repeat < 1:
-        p.error("--seconds must be > 0, --count and --repeat >= 1")
+    if a.seconds <= 0 or a.count < 1:
+        p.error("--seconds must be > 0, --count >= 1")
     ours = run_ours(a.count, a.seconds, a.warmup, not a.non_realtime,
                     a.repeat)
     ref_idle: list = []
     ref_loaded: list = []
-    if not a.no_reference and os.path.exists(REFERENCE_HALRUN):
-        if not os.access(REFERENCE_TOOL, os.X_OK):
-            print(f"reference tool {REFERENCE_TOOL} not found; "
-                  "skipping the reference", file=sys.stderr)
-        else:
-            for _ in range(a.repeat):
-                ref_idle.append(run_reference(0, a.seconds, a.warmup))
-                ref_loaded.append(run_reference(a.count, a.seconds,
-                                                a.warmup))
+    if use_reference(not a.no_reference, REFERENCE_HALRUN):
+        for _ in range(a.repeat):
+            ref_idle.append(run_reference(0, a.seconds, a.warmup))
+            ref_loaded.append(run_reference(a.count, a.seconds, a.warmup))
     report(a.count, a.seconds, a.repeat, ours, ref_idle, ref_loaded)
     return 0
 

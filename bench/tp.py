@@ -7,10 +7,9 @@ is cut into 20,000 straight lines of 0.05 mm (``--segments``,
 ``--tolerance``), and run on a simulated machine (motmod + trivkins +
 homemod + tpmod, motor-pos-cmd looped to motor-pos-fb,
 tests/lib/helpers/motion_trace.py) whose 1 kHz servo thread is stepped
-(deterministic mode).  The thread is
-made with ``timing_every=1``, so the ``.time`` pin of every function is
-measured on every cycle; a ``sampler`` at the end of the thread records
-them with the positions.
+(deterministic mode).  The thread is made with ``timing_every=1``, so
+the ``.time`` pin of every function is measured on every cycle; a
+``sampler`` at the end of the thread records them with the positions.
 
 Printed:
 
@@ -62,10 +61,12 @@ import time
 from typing import Optional
 
 import numpy as np
+from benchlib import add_repeat
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(os.path.dirname(HERE), "tests", "lib"))
 from helpers import motion_trace as mt  # noqa: E402
+from helpers import tp_api  # noqa: E402
 
 VEL = {"x": 200.0, "y": 200.0, "z": 100.0}
 ACC = {"x": 3000.0, "y": 3000.0, "z": 1500.0}
@@ -107,45 +108,7 @@ def queue_all(m: mt.Machine, prog: list, prequeue: bool) -> str:
 
 
 # ---------------------------------------------------------------- planner
-
-
-class _Pose(C.Structure):
-    _fields_ = [(n, C.c_double) for n in "xyzabcuvw"]
-
-
-class _Move(C.Structure):
-    _fields_ = [("id", C.c_int), ("type", C.c_int), ("vel", C.c_double),
-                ("ini_maxvel", C.c_double), ("acc", C.c_double),
-                ("jerk", C.c_double), ("term_cond", C.c_int),
-                ("tolerance", C.c_double), ("flags", C.c_uint),
-                # version 2 (zero: no G64 Q merging, not synchronized)
-                ("cam_tolerance", C.c_double), ("sync", C.c_int),
-                ("spindle", C.c_int), ("pitch", C.c_double)]
-
-
-_F = C.CFUNCTYPE
-_W = [C.c_char_p, C.c_int]
-
-
-class _Api(C.Structure):
-    """The first entries of tp.h's halsdk_tp_api_t (versions 1 and 2)."""
-    _fields_ = [
-        ("version", C.c_int),
-        ("init", _F(C.c_int, C.c_int, C.c_double, C.c_void_p, *_W)),
-        ("set_vel_limit", _F(None, C.c_double)),
-        ("set_axis_limits", _F(None, C.c_int, C.c_double, C.c_double)),
-        ("set_pos", _F(C.c_int, C.POINTER(_Pose), *_W)),
-        ("get_pos", _F(None, C.POINTER(_Pose))),
-        ("add_line", _F(C.c_int, C.POINTER(_Pose), C.POINTER(_Move), *_W)),
-        ("add_circle", C.c_void_p), ("add_probe", C.c_void_p),
-        ("set_dout", C.c_void_p), ("set_aout", C.c_void_p),
-        ("abort", C.c_void_p), ("pause", C.c_void_p),
-        ("resume", C.c_void_p), ("step", C.c_void_p),
-        ("set_scale", C.c_void_p),
-        ("run_cycle", _F(None, C.c_void_p, C.POINTER(_Pose))),
-        ("get_state", C.c_void_p),
-        ("is_done", _F(C.c_int)),
-    ]
+# tpmod's table and structures: tests/lib/helpers/tp_api.py
 
 
 def planner_alone(points: np.ndarray, feed: float, tol: float,
@@ -156,7 +119,8 @@ def planner_alone(points: np.ndarray, feed: float, tol: float,
 
     with halsdk.Hal(instance=f"benchtp-alone-{os.getpid()}") as hal:
         hal.loadrt("tpmod", queue_size=len(points) + 10)
-        api = _Api.from_address(_core.symbol_address("halsdk_tp_api"))
+        api = tp_api.TpApi.from_address(
+            _core.symbol_address("halsdk_tp_api"))
         why = C.create_string_buffer(200)
         if api.init(0, 1e-3, None, why, 200):
             print("planner alone: init failed:", why.value.decode(),
@@ -165,15 +129,16 @@ def planner_alone(points: np.ndarray, feed: float, tol: float,
         api.set_vel_limit(1e4)
         for k, a in enumerate("xyz"):
             api.set_axis_limits(k, VEL[a], ACC[a])
-        inputs = C.create_string_buffer(4096)       # zeros: no probe ...
-        out = _Pose()
+        inputs = tp_api.Inputs()        # zeros: no probe ...
+        out = tp_api.Pose9()
         clock = time.perf_counter_ns
         gc.disable()                # no collection inside a timed call
         adds = []
         for k, p in enumerate(points[1:]):
-            mv = _Move(id=k + 1, type=2, vel=feed, ini_maxvel=feed,
-                       acc=prog_acc, term_cond=2, tolerance=tol)
-            pose = _Pose(*p, 0, 0, 0, 0, 0, 0)
+            mv = tp_api.Move(id=k + 1, type=2, vel=feed, ini_maxvel=feed,
+                             acc=prog_acc, term_cond=tp_api.BLEND,
+                             tolerance=tol)
+            pose = tp_api.pose9(*p)
             t0 = clock()
             r = api.add_line(pose, mv, why, 200)
             adds.append(clock() - t0)
@@ -297,8 +262,7 @@ def main(argv: Optional[list[str]] = None) -> int:
     p.add_argument("--feed", type=float, default=5000, help="mm/min")
     p.add_argument("--tolerance", type=float, default=0.01,
                    help="G64 P, mm")
-    p.add_argument("--repeat", type=int, default=3,
-                   help="identical runs; per cycle the minimum is kept")
+    add_repeat(p, 3, "identical runs; per cycle the minimum is kept")
     p.add_argument("--prequeue", action="store_true",
                    help="queue everything while paused, then resume")
     p.add_argument("--no-planner", action="store_true",
@@ -306,7 +270,7 @@ def main(argv: Optional[list[str]] = None) -> int:
     a = p.parse_args(argv)
     feed = a.feed / 60
     r = run(a.segments, a.seg, feed, a.tolerance, a.prequeue,
-            not a.no_planner, max(1, a.repeat))
+            not a.no_planner, a.repeat)
     print(f"\ncoordinated planner: {a.segments} lines of {a.seg:g} mm "
           f"(3D, {r['length']:.1f} mm), F{a.feed:g} mm/min, "
           f"G64 P{a.tolerance:g}, 1 kHz servo thread stepped")

@@ -4,28 +4,20 @@ named shared blocks: C API version 4."""
 from __future__ import annotations
 
 import ctypes
-import os
 
 import pytest
-from helpers import data_path
-from helpers.environment import on_halsdk_path
-from helpers.halcompile import halcompile
+from helpers.halcompile import comp_files, compiled_on_path
 
 import halsdk
 from halsdk.core import _core
 
-COMPS = str(data_path("comps"))
 MODS = ["hcsymexp", "hcsymuse"]
 
 
 @pytest.fixture(scope="module")
 def sym_dir(tmp_path_factory: pytest.TempPathFactory):
-    folder = str(tmp_path_factory.mktemp("sym-modules"))
-    proc = halcompile("--compile",
-                      *[os.path.join(COMPS, n + ".comp") for n in MODS],
-                      cwd=folder)
-    assert proc.returncode == 0, proc.stderr
-    with on_halsdk_path(folder):
+    with compiled_on_path(tmp_path_factory.mktemp("sym-modules"),
+                          *comp_files(*MODS)) as folder:
         yield folder
 
 

@@ -9,12 +9,13 @@ import os
 import shutil
 import subprocess
 import sys
-import time
 
 import can
 import cantools
 import pytest
 from helpers import repo_path
+from helpers.fixtures import factory
+from helpers.polling import wait_for
 from helpers.processes import ended_at_exit, sigterm
 
 from halsdk.driverkit import FAULT_OPEN, FAULT_READ, IOLoop
@@ -85,14 +86,8 @@ class Rig:
 
 @pytest.fixture
 def rig(hal):
-    made: list[Rig] = []
-
-    def make(*args: str) -> Rig:
-        made.append(Rig(*args))
-        return made[-1]
-    yield make
-    for r in made:
-        r.close()
+    with factory(Rig, Rig.close) as make:
+        yield make
 
 
 STATUS = {"ActualSpeed": -1234.5, "Enabled": 1, "State": 2,
@@ -401,15 +396,6 @@ def test_bad_dbc_exits_with_file_and_line(tmp_path, hal):
         proc = run_program(args, tmp_path)
         assert proc.returncode == 1 and text in proc.stderr, proc.stderr
         assert len(proc.stderr.splitlines()) == 1
-
-
-def wait_for(predicate, timeout: float = 10.0) -> bool:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        if predicate():
-            return True
-        time.sleep(0.02)
-    return predicate()
 
 
 def test_process_sends_and_stops_on_sigterm(tmp_path, hal):

@@ -16,6 +16,7 @@ from pathlib import Path
 import can
 import pytest
 from helpers import repo_path
+from helpers.fixtures import factory
 
 from halsdk.driverkit import IOLoop
 from halsdk.drivers.cia402 import statemachine as sm
@@ -77,14 +78,10 @@ class Rig:
 
 @pytest.fixture
 def rig_for(hal, tmp_path):
-    rigs = []
-
     def make(drives: str = CSP_DRIVE, bus: str = "") -> Rig:
-        rigs.append(Rig(hal, write_ini(tmp_path, drives, bus)))
-        return rigs[-1]
-    yield make
-    for rig in rigs:
-        rig.stop()
+        return Rig(hal, write_ini(tmp_path, drives, bus))
+    with factory(make, Rig.stop) as made:
+        yield made
 
 
 def enable(rig: Rig, num: int = 0) -> None:

@@ -17,6 +17,8 @@ import tty
 
 import pytest
 from helpers import REPO
+from helpers.fixtures import factory
+from helpers.polling import wait_for
 
 from halsdk.drivers.mb2hal import ConfigError, Mb2hal, load_config
 from halsdk.drivers.mb2hal.client import ModbusLink
@@ -26,15 +28,6 @@ _spec = importlib.util.spec_from_file_location(
     "mb2hal_simulator", ROOT / "examples" / "modbus" / "simulator.py")
 sim = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(sim)
-
-
-def wait_for(check, timeout=5.0):
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        if check():
-            return True
-        time.sleep(0.01)
-    return check()
 
 
 def free_port() -> int:
@@ -80,16 +73,12 @@ def server():
 
 @pytest.fixture
 def engine_of(hal):
-    started = []
-
-    def make(path, **kw):
+    def start(path, **kw):
         eng = Mb2hal(load_config(path), **kw)
         eng.start()
-        started.append(eng)
         return eng
-    yield make
-    for eng in started:
-        eng.stop()
+    with factory(start, Mb2hal.stop) as make:
+        yield make
 
 
 def test_all_eight_function_codes_both_ways(tmp_path, hal, server,

@@ -18,6 +18,7 @@ from typing import Any, Callable
 import paho.mqtt.client as mqtt
 import pytest
 from helpers import repo_path
+from helpers.fixtures import factory
 from paho.mqtt.enums import CallbackAPIVersion
 
 import halsdk
@@ -108,14 +109,8 @@ class Listener:
 
 @pytest.fixture
 def listeners():
-    made: list[Listener] = []
-
-    def make(port: int, *topics: str) -> Listener:
-        made.append(Listener(port, *topics))
-        return made[-1]
-    yield make
-    for lst in made:
-        lst.close()
+    with factory(Listener, Listener.close) as make:
+        yield make
 
 
 @pytest.fixture
@@ -136,20 +131,15 @@ def source(hal):
 
 @pytest.fixture
 def bridges():
-    made: list[Bridge] = []
-
-    def make(port: int, **kw: Any) -> Bridge:
+    def start(port: int, **kw: Any) -> Bridge:
         kw.setdefault("prefix", PREFIX)
         kw.setdefault("backoff", 0.05)
         kw.setdefault("backoff_max", 0.2)
-        cfg = BridgeConfig(broker="127.0.0.1", port=port, **kw)
-        b = Bridge(cfg)
+        b = Bridge(BridgeConfig(broker="127.0.0.1", port=port, **kw))
         b.start()
-        made.append(b)
         return b
-    yield make
-    for b in made:
-        b.shutdown()
+    with factory(start, Bridge.shutdown) as make:
+        yield make
 
 
 def connected(bridge: Bridge, timeout: float = 8.0) -> bool:

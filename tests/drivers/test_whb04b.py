@@ -13,6 +13,7 @@ from pathlib import Path
 
 import pytest
 from helpers import data_path
+from helpers.polling import wait_for
 from helpers.processes import ended_at_exit, sigterm
 
 from halsdk.driverkit import FAULT_NONE, FAULT_OPEN, FAULT_READ, IOLoop
@@ -259,15 +260,6 @@ def test_replay_script_errors():
 
 # -------------------------------------------------------------- programs
 
-def _wait(cond, timeout: float = 10.0) -> bool:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        if cond():
-            return True
-        time.sleep(0.02)
-    return cond()
-
-
 def _replayers(marker: str) -> list[int]:
     """Driver processes whose command line names ``marker``."""
     found = []
@@ -303,14 +295,14 @@ def test_loadusr_replay_and_unloadusr(hal, tmp_path, python_tools_first):
     try:
         rc, out = _halcmd(tmp_path, f"loadusr -W whb04b --replay {script}")
         assert rc == 0, out
-        assert _wait(lambda: hal.getp(P + "encoder.00.count") == 7)
+        assert wait_for(lambda: hal.getp(P + "encoder.00.count") == 7)
         assert hal.getp(P + "button.stop") and hal.getp(P + "axis.b")
         assert hal.getp(P + "jog.increment") == pytest.approx(1.0)
         assert hal.getp(P + "connected") and not hal.getp(P + "fault")
         assert len(_replayers(str(tmp_path))) == 1
         rc, out = _halcmd(tmp_path, "unloadusr whb04b")
         assert rc == 0, out
-        assert _wait(lambda: not _replayers(str(tmp_path)))
+        assert wait_for(lambda: not _replayers(str(tmp_path)))
         assert not hal.pins("whb04b.*")
     finally:
         for pid in _replayers(str(tmp_path)):
@@ -323,10 +315,10 @@ def test_program_demo_sigterm_and_bad_file(hal, tmp_path):
          "-n", "pendant"], cwd=tmp_path, stdout=subprocess.PIPE,
         stderr=subprocess.PIPE, text=True)
     with ended_at_exit(proc):
-        assert _wait(lambda: bool(hal.pins(P + "connected"))
+        assert wait_for(lambda: bool(hal.pins(P + "connected"))
                      and hal.getp(P + "connected"))
         assert "pendant" in [c.name for c in hal.components()]
-        assert _wait(lambda: hal.getp(P + "jog.mode-lead"))   # last report
+        assert wait_for(lambda: hal.getp(P + "jog.mode-lead"))   # last report
         assert hal.getp(P + "encoder.00.count") == 16
         assert hal.getp(P + "axis.z") and not hal.getp(P + "button.fn")
         out, err = sigterm(proc, 10)
@@ -350,7 +342,7 @@ def test_program_without_device_faults_and_stops(hal, tmp_path):
          "fffe"], cwd=tmp_path, stdout=subprocess.PIPE,
         stderr=subprocess.PIPE, text=True)
     with ended_at_exit(proc):
-        assert _wait(lambda: bool(hal.pins(P + "fault-code"))
+        assert wait_for(lambda: bool(hal.pins(P + "fault-code"))
                      and hal.getp(P + "fault-code") == FAULT_OPEN)
         assert hal.getp(P + "fault") and not hal.getp(P + "connected")
         time.sleep(0.5)                      # several attempts, backed off

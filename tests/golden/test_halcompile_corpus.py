@@ -24,7 +24,14 @@ import time
 
 import pytest
 from helpers import data_path
-from helpers.environment import on_halsdk_path
+from helpers.components import names, own_params, own_pins
+from helpers.halcompile import (
+    child_env,
+    comp_files,
+    compiled_on_path,
+    halcompile,
+    halrun_file,
+)
 
 from halcompile import parse, parse_file
 from halsdk.build import extension_suffix
@@ -48,46 +55,13 @@ USER_COMPS = ["hcuser3", "hcuserlink"]
 ALL = C_COMPS + CY_COMPS + USER_COMPS
 
 
-def _env(**extra: str) -> dict:
-    """The environment of a child: the packages this test imported, never
-    the repository root (no compiled core there in a fresh clone)."""
-    import halcompile as hc
-    import halsdk
-    env = dict(os.environ)
-    dirs = {os.path.dirname(os.path.dirname(m.__file__)) for m in (hc, halsdk)}
-    env["PYTHONPATH"] = os.pathsep.join([*sorted(dirs),
-                                         env.get("PYTHONPATH", "")])
-    env.update(extra)
-    return env
-
-
 @pytest.fixture(scope="module")
 def corpus(tmp_path_factory: pytest.TempPathFactory):
     """Every comp of this corpus compiled by ``halcompile --compile`` into
     one folder, which is put first on HALSDK_PATH."""
-    folder = str(tmp_path_factory.mktemp("hc-corpus"))
-    proc = subprocess.run(
-        [sys.executable, "-m", "halcompile", "--compile",
-         *[os.path.join(COMPS, n + ".comp") for n in ALL]],
-        cwd=folder, env=_env(), capture_output=True, text=True)
-    assert proc.returncode == 0, proc.stderr
-    with on_halsdk_path(folder):
+    with compiled_on_path(tmp_path_factory.mktemp("hc-corpus"),
+                          *comp_files(*ALL)) as folder:
         yield folder
-
-
-def names(handles) -> list[str]:
-    return [h.name for h in handles]
-
-
-def own_pins(hal, pattern: str) -> list[str]:
-    """Pins of a component, without the timing pins of its functions."""
-    return [n for n in names(hal.pins(pattern)) if not n.endswith(".time")]
-
-
-def own_params(hal, pattern: str) -> list[str]:
-    """Params of a component, without the timing params of its functions."""
-    return [n for n in names(hal.params(pattern))
-            if not n.endswith((".tmax", ".tmax-increased"))]
 
 
 def run_functs(hal, *functs: str) -> None:
@@ -446,10 +420,8 @@ def test_documentation_declarations(hal, corpus, tmp_path):
     assert comp.license == "GPL v2 or later"
     assert comp.description == r"A set/reset latch: \fBset\fR wins."
     assert comp.functions[0].doc == "the only function"
-    proc = subprocess.run(
-        [sys.executable, "-m", "halcompile", "--document",
-         os.path.join(COMPS, "hcdocdecl.comp")],
-        cwd=str(tmp_path), env=_env(), capture_output=True, text=True)
+    proc = halcompile("--document", *comp_files("hcdocdecl"),
+                      cwd=str(tmp_path))
     assert proc.returncode == 0, proc.stderr
     page = (tmp_path / "hcdocdecl.9").read_text()
     for text in ("Written for the halsdk test corpus.", "hcio(9)",
@@ -523,15 +495,12 @@ def driven(tmp_path_factory: pytest.TempPathFactory) -> dict:
     build = folder / "build"
     build.mkdir()
     comps = sorted({c.partition(":")[0] for c in REFERENCE_GENERATED})
-    proc = subprocess.run(
-        [sys.executable, "-m", "halcompile", "--compile",
-         *[os.path.join(COMPS, n + ".comp") for n in comps]],
-        cwd=str(build), env=_env(), capture_output=True, text=True)
+    proc = halcompile("--compile", *comp_files(*comps), cwd=str(build))
     assert proc.returncode == 0, proc.stderr
     proc = subprocess.run(
         [sys.executable, os.path.join(DATA, "drive.py"), "out.json",
          *REFERENCE_GENERATED],
-        cwd=str(folder), env=_env(HALSDK_PATH=str(build)),
+        cwd=str(folder), env=child_env(HALSDK_PATH=str(build)),
         capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stderr
     with open(folder / "out.json", encoding="utf-8") as f:
@@ -587,19 +556,15 @@ def test_realtime_c_module_sees_rtapi_defined(tmp_path):
     """Realtime builds define RTAPI, as LinuxCNC's module build does: real
     modules include rtapi_app.h under #ifdef RTAPI."""
     (tmp_path / "hcguard.c").write_text(RTAPI_GUARDED_C)
-    proc = subprocess.run([sys.executable, "-m", "halcompile", "--compile",
-                           "hcguard.c"], cwd=str(tmp_path), env=_env(),
-                          capture_output=True, text=True)
+    proc = halcompile("--compile", "hcguard.c", cwd=str(tmp_path))
     assert proc.returncode == 0, proc.stderr
 
 
 def test_realtime_c_module_with_rtapi_given(tmp_path):
     """The same file builds when RTAPI is given on the command line."""
     (tmp_path / "hcguard.c").write_text(RTAPI_GUARDED_C)
-    proc = subprocess.run([sys.executable, "-m", "halcompile", "--compile",
-                           "--extra-compile-args=-DRTAPI", "hcguard.c"],
-                          cwd=str(tmp_path), env=_env(),
-                          capture_output=True, text=True)
+    proc = halcompile("--compile", "--extra-compile-args=-DRTAPI",
+                      "hcguard.c", cwd=str(tmp_path))
     assert proc.returncode == 0, proc.stderr
     assert os.path.isfile(tmp_path / ("hcguard" + extension_suffix()))
 
@@ -610,7 +575,8 @@ def test_userspace_extra_compile_and_link_args(hal, corpus):
     """The launcher, started as a child attached to the test's instance:
     -DGAIN=3 reached the compiler and -lm the linker (pow)."""
     proc = subprocess.Popen([os.path.join(corpus, "hcuserlink")],
-                            cwd=corpus, env=_env(), stdout=subprocess.PIPE,
+                            cwd=corpus, env=child_env(),
+                            stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True)
     try:
         deadline = time.monotonic() + 20
@@ -642,9 +608,7 @@ def test_userspace_against_the_reference(corpus, tmp_path, name):
     shutil.copy2(os.path.join(DATA, name + ".hal"), tmp_path / "run.hal")
     with open(os.path.join(DATA, name + ".out"), encoding="utf-8") as f:
         golden = f.read()
-    proc = subprocess.run([sys.executable, "-m", "halsdk.halcmd.cli",
-                           "halrun", "-f", "run.hal"], cwd=str(tmp_path),
-                          env=_env(HALSDK_INSTANCE=f"hcu{os.getpid()}"),
-                          capture_output=True, text=True, timeout=60)
+    proc = halrun_file("run.hal", tmp_path,
+                       HALSDK_INSTANCE=f"hcu{os.getpid()}")
     assert proc.returncode == 0, proc.stderr
     assert normalize(proc.stdout) == normalize(golden)

@@ -9,8 +9,8 @@ import sys
 
 import pytest
 from helpers import data_path
-from helpers.environment import on_halsdk_path
-from helpers.halcompile import halcompile
+from helpers.components import names, own_pins
+from helpers.halcompile import check_ddt, comp_files, compiled_on_path, halcompile
 
 import halsdk
 from halcompile import CompError, parse, parse_file
@@ -29,22 +29,9 @@ PERIOD = 1_000_000
 def comp_dir(tmp_path_factory: pytest.TempPathFactory):
     """All the good test comps, compiled by the command into a folder that
     is put first on HALSDK_PATH."""
-    folder = str(tmp_path_factory.mktemp("hc-modules"))
-    proc = halcompile("--compile",
-                      *[os.path.join(COMPS, n + ".comp") for n in GOOD],
-                      cwd=folder)
-    assert proc.returncode == 0, proc.stderr
-    with on_halsdk_path(folder):
+    with compiled_on_path(tmp_path_factory.mktemp("hc-modules"),
+                          *comp_files(*GOOD)) as folder:
         yield folder
-
-
-def names(handles) -> list[str]:
-    return [h.name for h in handles]
-
-
-def own_pins(hal, pattern: str) -> list[str]:
-    """Pins of a component, without the timing pins of its functions."""
-    return [n for n in names(hal.pins(pattern)) if not n.endswith(".time")]
 
 
 # ------------------------------------------------------------ the modules
@@ -58,16 +45,7 @@ def test_compile_writes_one_module_per_comp(comp_dir):
 def test_ddt_derivative_is_exact(hal, comp_dir):
     assert hal.loadrt("hcddt") == ["hcddt"]
     assert own_pins(hal, "hcddt.*") == ["hcddt.0.in", "hcddt.0.out"]
-    hal.newthread("servo", PERIOD)
-    hal.addf("hcddt.0", "servo")
-    inputs = [0.0, 0.5, 2.0, 1.25, -3.0, -3.0, 7.75]
-    trace = hal.run(len(inputs), inputs={"hcddt.0.in": inputs},
-                    record=["hcddt.0.out"])
-    old, want = 0.0, []
-    for x in inputs:
-        want.append((x - old) / (PERIOD * 1e-9))
-        old = x
-    assert list(trace["hcddt.0.out"]) == want
+    check_ddt(hal, "hcddt.0", "hcddt.0.in", "hcddt.0.out", PERIOD)
 
 
 def test_delay_times_its_edges(hal, comp_dir):

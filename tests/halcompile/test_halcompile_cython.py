@@ -7,8 +7,8 @@ import os
 
 import pytest
 from helpers import REPO, data_path
-from helpers.environment import on_halsdk_path
-from helpers.halcompile import halcompile
+from helpers.components import own_pins
+from helpers.halcompile import check_ddt, comp_files, compiled_on_path, halcompile
 
 from halcompile import CompError, parse
 from halcompile.gen_cython import CythonSourceError, generate, split_code
@@ -21,11 +21,8 @@ PERIOD = 1_000_000
 
 @pytest.fixture(scope="module")
 def cy_dir(tmp_path_factory: pytest.TempPathFactory):
-    folder = str(tmp_path_factory.mktemp("hc-cython"))
-    proc = halcompile("--compile", os.path.join(COMPS, "hccyddt.comp"),
-                      os.path.join(COMPS, "hccymulti.comp"), cwd=folder)
-    assert proc.returncode == 0, proc.stderr
-    with on_halsdk_path(folder):
+    with compiled_on_path(tmp_path_factory.mktemp("hc-cython"),
+                          *comp_files("hccyddt", "hccymulti")) as folder:
         yield folder
 
 
@@ -36,17 +33,8 @@ def test_modules_are_built(cy_dir):
 
 def test_cython_ddt_is_exact(hal, cy_dir):
     hal.loadrt("hccyddt", "names=d")
-    assert [p.name for p in hal.pins("d.*") if not p.name.endswith(".time")
-            ] == ["d.in", "d.out"]
-    hal.newthread("servo", PERIOD)
-    hal.addf("d", "servo")
-    inputs = [0.0, 0.5, 2.0, 1.25, -3.0, -3.0, 7.75]
-    trace = hal.run(len(inputs), inputs={"d.in": inputs}, record=["d.out"])
-    old, want = 0.0, []
-    for x in inputs:
-        want.append((x - old) / (PERIOD * 1e-9))
-        old = x
-    assert list(trace["d.out"]) == want
+    assert own_pins(hal, "d.*") == ["d.in", "d.out"]
+    check_ddt(hal, "d", "d.in", "d.out", PERIOD)
 
 
 def test_cython_multi_function_component(hal, cy_dir):

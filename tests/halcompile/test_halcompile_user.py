@@ -14,6 +14,7 @@ import time
 
 import pytest
 from helpers import data_path
+from helpers.halcompile import child_env, halcompile, halrun_file
 
 from halcompile import CompError, parse
 from halcompile.gen_c import generate
@@ -21,23 +22,6 @@ from halsdk.build import extension_suffix
 from halsdk.errors import LoadError
 
 COMPS = str(data_path("comps"))
-
-
-def _env(**extra: str) -> dict:
-    env = dict(os.environ)
-    import halcompile as hc
-    import halsdk
-    dirs = {os.path.dirname(os.path.dirname(m.__file__)) for m in (hc, halsdk)}
-    env["PYTHONPATH"] = os.pathsep.join([*sorted(dirs),
-                                         env.get("PYTHONPATH", "")])
-    env.update(extra)
-    return env
-
-
-def halcompile(*args: str, cwd: str, **env: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "halcompile", *args],
-                          cwd=cwd, env=_env(**env), capture_output=True,
-                          text=True)
 
 
 @pytest.fixture(scope="module")
@@ -62,7 +46,8 @@ def wait_for(cond, timeout: float = 10.0) -> None:
 def start(folder: str, *args: str) -> subprocess.Popen:
     """Start a launcher as a child attached to the test's instance."""
     return subprocess.Popen([os.path.join(folder, args[0]), *args[1:]],
-                            cwd=folder, env=_env(), stdout=subprocess.PIPE,
+                            cwd=folder, env=child_env(),
+                            stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True)
 
 
@@ -83,7 +68,7 @@ def test_compile_writes_module_and_executable_launcher(progs):
 
 def test_launcher_without_instance_fails_cleanly(progs, tmp_path):
     proc = subprocess.run([os.path.join(progs, "hcuser")], cwd=str(tmp_path),
-                          env=_env(HALSDK_INSTANCE=f"none{os.getpid()}"),
+                          env=child_env(HALSDK_INSTANCE=f"none{os.getpid()}"),
                           capture_output=True, text=True)
     assert proc.returncode == 1
     assert "no HAL instance" in proc.stderr
@@ -149,7 +134,7 @@ def test_mainloop_return_ends_program_and_removes_comp(hal, progs):
 
 def test_count_and_names_together_fail(hal, progs):
     proc = subprocess.run([os.path.join(progs, "hcuser"), "count=2",
-                           "names=a"], cwd=progs, env=_env(),
+                           "names=a"], cwd=progs, env=child_env(),
                           capture_output=True, text=True, timeout=20)
     assert proc.returncode == 1
     assert "count= and names= are mutually exclusive" in proc.stderr
@@ -188,12 +173,9 @@ def test_loadusr_from_halrun_file(progs, tmp_path):
         "getp hcprog.out\n"
         "unloadusr hcprog\n"
         "show comp\n")
-    env = _env(PATH=progs + os.pathsep + os.environ["PATH"],
-               HALSDK_INSTANCE=f"hcuser{os.getpid()}")
-    proc = subprocess.run([sys.executable, "-m", "halsdk.halcmd.cli",
-                           "halrun", "-f", str(hal_file)], cwd=str(tmp_path),
-                          env=env, capture_output=True, text=True,
-                          timeout=60)
+    proc = halrun_file(hal_file, tmp_path,
+                       PATH=progs + os.pathsep + os.environ["PATH"],
+                       HALSDK_INSTANCE=f"hcuser{os.getpid()}")
     assert proc.returncode == 0, proc.stderr
     lines = proc.stdout.splitlines()
     assert lines[0] == "6.25"
@@ -213,19 +195,16 @@ def test_loadusr_finds_launchers_on_halsdk_path(progs, tmp_path):
                         "loadusr -w sleep 0.3\n"
                         "getp beta.out\n"
                         "unload hcuser\n")
-    env = _env(HALSDK_PATH=progs, HALSDK_INSTANCE=f"hcpath{os.getpid()}")
-    assert progs not in env["PATH"].split(os.pathsep)
-    proc = subprocess.run([sys.executable, "-m", "halsdk.halcmd.cli",
-                           "halrun", "-f", str(hal_file)], cwd=str(tmp_path),
-                          env=env, capture_output=True, text=True,
-                          timeout=60)
+    assert progs not in os.environ["PATH"].split(os.pathsep)
+    proc = halrun_file(hal_file, tmp_path, HALSDK_PATH=progs,
+                       HALSDK_INSTANCE=f"hcpath{os.getpid()}")
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.splitlines()[0] == "3.5"      # 1.5 * 2 + offset
 
 
 def test_userspace_program_exit_status(hal, progs):
     proc = subprocess.run([os.path.join(progs, "hcprog"), "fail"],
-                          cwd=progs, env=_env(), capture_output=True,
+                          cwd=progs, env=child_env(), capture_output=True,
                           text=True, timeout=20)
     assert proc.returncode == 3
     child = start(progs, "hcprog", "-2")
@@ -256,7 +235,7 @@ def test_install_writes_launcher_to_user_bin(hal, tmp_path):
     # found by name on PATH, from anywhere
     child = subprocess.Popen(
         ["hcuser", "names=inst"], cwd=str(tmp_path),
-        env=_env(PATH=str(bin_dir) + os.pathsep + os.environ["PATH"]))
+        env=child_env(PATH=str(bin_dir) + os.pathsep + os.environ["PATH"]))
     try:
         wait_for(lambda: ready(hal, "hcuser"))
         assert hal.component("hcuser").pid == child.pid
@@ -322,9 +301,7 @@ def test_same_output_as_the_reference(progs, tmp_path):
         for file in (name, name + extension_suffix()):
             shutil.copy2(os.path.join(progs, file), tmp_path / file)
     (tmp_path / "run.hal").write_text(script)
-    proc = subprocess.run([sys.executable, "-m", "halsdk.halcmd.cli",
-                           "halrun", "-f", "run.hal"], cwd=str(tmp_path),
-                          env=_env(HALSDK_INSTANCE=f"hcref{os.getpid()}"),
-                          capture_output=True, text=True, timeout=60)
+    proc = halrun_file("run.hal", tmp_path,
+                       HALSDK_INSTANCE=f"hcref{os.getpid()}")
     assert proc.returncode == 0, proc.stderr
     assert _normalize(proc.stdout) == _normalize(golden)

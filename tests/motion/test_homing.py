@@ -15,35 +15,25 @@ its command exactly, one cycle late.
 from __future__ import annotations
 
 import ctypes as C
+import functools
 import math
 
 import numpy as np
 import pytest
+from helpers.fixtures import factory
 
 import halsdk
 from halsdk.core import _core
 from halsdk.motion import HOME_SEQUENCE_NONE, HomeFlag, JointFlag
 
+# the protocol's numbers (HomeFlag, JointFlag, HOME_SEQUENCE_NONE: the
+# home_sequence of a joint not in "home all") come from the compiled
+# headers, never typed here
+
 DT = 0.001
 PERIOD_NS = 1_000_000
 INDEX_PITCH = 1.0           # motor units between index marks
 INDEX_PHASE = 0.37          # first mark at this motor position (mod pitch)
-
-# the protocol's numbers, from the compiled headers (never typed here)
-HOME_IGNORE_LIMITS = HomeFlag.IGNORE_LIMITS
-HOME_USE_INDEX = HomeFlag.USE_INDEX
-HOME_IS_SHARED = HomeFlag.IS_SHARED
-HOME_ABSOLUTE_ENCODER = HomeFlag.ABSOLUTE_ENCODER
-HOME_NO_REHOME = HomeFlag.NO_REHOME
-HOME_NO_FINAL_MOVE = HomeFlag.NO_FINAL_MOVE
-HOME_INDEX_NO_ENCODER_RESET = HomeFlag.INDEX_NO_ENCODER_RESET
-
-# home_sequence of a joint that is not in "home all": key absent
-SEQ_NONE = HOME_SEQUENCE_NONE
-
-MOT_JOINT_ACTIVE = JointFlag.ACTIVE
-MOT_JOINT_HOMING = JointFlag.HOMING
-MOT_JOINT_HOMED = JointFlag.HOMED
 
 # home-state numbers of homemod (docs/homing.rst)
 HS_IDLE, HS_LATCH, HS_INDEX, HS_SYNC, HS_FINAL = 0, 8, 9, 11, 12
@@ -149,7 +139,7 @@ class Rig:
         for k in range(n):
             jt = self.j[k]
             jt.index = k
-            jt.flags = MOT_JOINT_ACTIVE
+            jt.flags = JointFlag.ACTIVE
             jt.min_pos_limit, jt.max_pos_limit = limits
             jt.vel_limit = vel
             jt.acc_limit = acc
@@ -186,7 +176,7 @@ class Rig:
 
     # -- configuration and commands --
     def params(self, k, **kw) -> int:
-        p = HomeParams(home_sequence=SEQ_NONE)
+        p = HomeParams(home_sequence=HOME_SEQUENCE_NONE)
         for key, v in kw.items():
             setattr(p, key, v)
         self.why = C.create_string_buffer(200)
@@ -277,15 +267,9 @@ class Rig:
 
 @pytest.fixture
 def rig(hal):
-    made = []
-
-    def make(*args, **kw):
-        r = Rig(hal, *args, **kw)
-        made.append(r)
-        return r
-    yield make
-    for r in made:
-        _core.comp_exit(r.cid)
+    with factory(functools.partial(Rig, hal),
+                 lambda r: _core.comp_exit(r.cid)) as make:
+        yield make
 
 
 def physical(r, k, pos):
@@ -385,7 +369,7 @@ def test_switch_closed_at_start_backs_off_first(hal, rig):
 def test_switch_then_index(hal, rig, reset):
     r = rig(1, switch=[2.0])
     r.reset[0] = reset
-    flags = HOME_USE_INDEX | (0 if reset else HOME_INDEX_NO_ENCODER_RESET)
+    flags = HomeFlag.USE_INDEX | (0 if reset else HomeFlag.INDEX_NO_ENCODER_RESET)
     assert r.params(0, home_offset=0.5, home=0.0, home_search_vel=4.0,
                     home_latch_vel=-0.3, home_sequence=0, flags=flags) == 0
     assert r.start(0) == 0
@@ -415,7 +399,7 @@ def test_switch_then_index(hal, rig, reset):
 def test_index_only_when_search_vel_zero(hal, rig):
     r = rig(1, start=[0.2])
     assert r.params(0, home_offset=3.0, home=2.0, home_latch_vel=0.25,
-                    home_sequence=0, flags=HOME_USE_INDEX) == 0
+                    home_sequence=0, flags=HomeFlag.USE_INDEX) == 0
     assert r.start(0) == 0
     tr = r.run()[0]
     assert r.api.is_homed(0), r.error()
@@ -429,7 +413,7 @@ def test_index_pulse_not_found(hal, rig):
     r = rig(3, limits=(0.0, 2.0))
     r.index_on[2] = False
     assert r.params(2, home_latch_vel=1.0, home_sequence=0,
-                    flags=HOME_USE_INDEX) == 0
+                    flags=HomeFlag.USE_INDEX) == 0
     assert r.start(2) == 0
     r.run()
     assert not r.api.is_homed(2)
@@ -456,7 +440,7 @@ def test_no_final_move_ends_near_the_latch_point(hal, rig):
     r = rig(1, switch=[1.0])
     assert r.params(0, home_offset=3.0, home=0.0, home_search_vel=2.0,
                     home_latch_vel=0.2, home_sequence=0,
-                    flags=HOME_NO_FINAL_MOVE) == 0
+                    flags=HomeFlag.NO_FINAL_MOVE) == 0
     r.start(0)
     tr = r.run()[0]
     assert r.api.is_homed(0)
@@ -468,7 +452,7 @@ def test_no_final_move_ends_near_the_latch_point(hal, rig):
 @pytest.mark.parametrize("mode,final", [(1, True), (2, False)])
 def test_absolute_encoder(hal, rig, mode, final):
     r = rig(1, start=[7.0])
-    flags = HOME_ABSOLUTE_ENCODER | (HOME_NO_FINAL_MOVE if mode == 2 else 0)
+    flags = HomeFlag.ABSOLUTE_ENCODER | (HomeFlag.NO_FINAL_MOVE if mode == 2 else 0)
     assert r.params(0, home_offset=2.0, home=1.0, home_search_vel=5.0,
                     home_latch_vel=1.0, home_sequence=0, flags=flags) == 0
     r.step()
@@ -557,7 +541,7 @@ def test_home_all_refuses_gaps_and_bad_start(hal, rig):
     assert "must start at 0 or 1" in r.reason()
     r2 = r
     for k in range(3):
-        r2.params(k, home_sequence=SEQ_NONE)
+        r2.params(k, home_sequence=HOME_SEQUENCE_NONE)
     assert r.start(-1) < 0 and "no joint has a HOME_SEQUENCE" in r.reason()
 
 
@@ -591,7 +575,7 @@ def test_home_all_skips_inactive_joints(hal, rig):
 def test_shared_switch_closed_refuses(hal, rig):
     r = rig(1, switch=[0.5], start=[1.0])
     r.params(0, home_search_vel=1.0, home_latch_vel=0.1, home_sequence=0,
-             flags=HOME_IS_SHARED)
+             flags=HomeFlag.IS_SHARED)
     r.step()
     assert r.start(0) < 0
     assert r.reason() == ("joint 0 home switch already closed at start of "
@@ -606,11 +590,11 @@ def test_shared_switch_closed_when_its_sequence_starts(hal, rig):
     hal.unlinkp("joint.1.home-sw-in")
     hal.linkps("joint.1.home-sw-in", "sw0")     # one wire, two joints
     r.params(0, home_offset=0.0, home=0.5, home_search_vel=1.0,
-             home_latch_vel=0.1, home_sequence=0, flags=HOME_IS_SHARED,
+             home_latch_vel=0.1, home_sequence=0, flags=HomeFlag.IS_SHARED,
              home_final_vel=1.0)
     # joint 0 ends on the switch (HOME = switch point)
     r.params(1, home_search_vel=1.0, home_latch_vel=0.1, home_sequence=1,
-             flags=HOME_IS_SHARED)
+             flags=HomeFlag.IS_SHARED)
     assert r.start(-1) == 0
     r.run()
     assert r.api.is_homed(0) and not r.api.is_homed(1)
@@ -623,7 +607,7 @@ def test_ignore_limits_only_while_homing(hal, rig):
     r = rig(2, switch=[1.0, 1.0])
     for k in range(2):
         r.params(k, home_search_vel=2.0, home_latch_vel=0.5,
-                 home_sequence=0, flags=HOME_IGNORE_LIMITS if k == 0 else 0)
+                 home_sequence=0, flags=HomeFlag.IGNORE_LIMITS if k == 0 else 0)
     assert not r.api.ignores_limits(0)
     r.start(-1)
     r.step()
@@ -676,7 +660,7 @@ def test_unhome_and_volatile(hal, rig):
     assert [r.api.is_homed(k) for k in range(3)] == [1, 0, 1]
     assert r.unhome(2) == 0
     assert [r.api.is_homed(k) for k in range(3)] == [1, 0, 0]
-    assert r.j[2].flags & MOT_JOINT_HOMED == 0
+    assert r.j[2].flags & JointFlag.HOMED == 0
     assert r.unhome(-1) == 0 and not r.api.is_homed(0)
     assert r.unhome(5) < 0 and r.reason() == \
         "joint 5 does not exist (num_joints=3)"
@@ -684,7 +668,7 @@ def test_unhome_and_volatile(hal, rig):
 
 def test_no_rehome(hal, rig):
     r = rig(1)
-    r.params(0, home_sequence=0, flags=HOME_NO_REHOME)
+    r.params(0, home_sequence=0, flags=HomeFlag.NO_REHOME)
     r.start(0)
     r.run()
     assert r.start(0) < 0 and "HOME_NO_REHOME" in r.reason()
@@ -700,7 +684,7 @@ def test_no_rehome(hal, rig):
     ({"home_offset": math.nan}, "HOME_OFFSET is not a finite"),
     ({"home_search_vel": math.inf, "home_latch_vel": 1}, "HOME_SEARCH_VEL"),
     ({"home_search_vel": 2.0}, "HOME_LATCH_VEL is 0"),
-    ({"flags": HOME_USE_INDEX}, "HOME_USE_INDEX needs a nonzero"),
+    ({"flags": HomeFlag.USE_INDEX}, "HOME_USE_INDEX needs a nonzero"),
     ({"home": 11.0}, "outside the soft limits"),
     ({"home_sequence": 40}, "HOME_SEQUENCE 40 is out of range"),
     ({"flags": 0x1000}, "unknown homing flags"),

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import pytest
 from helpers import data_path, repo_path
-from helpers.environment import on_halsdk_path
+from helpers.halcompile import compiled_on_path
 
 import halsdk
 from halsdk.core import _core
@@ -462,14 +462,10 @@ def _doc_block(caption_or_lang: str) -> str:
 
 @pytest.fixture
 def skewkins_dir(tmp_path: Path):
-    from helpers.halcompile import halcompile
     (tmp_path / "skewkins.c").write_text(_doc_block("skewkins.c"))
     # kinematics.h and emcpose.h are installed headers: no -I needed
-    proc = halcompile("--compile", "--extra-compile-args",
-                      "-Wall -Werror", "skewkins.c",
-                      cwd=str(tmp_path))
-    assert proc.returncode == 0, proc.stderr
-    with on_halsdk_path(str(tmp_path)):
+    with compiled_on_path(tmp_path, "--extra-compile-args", "-Wall -Werror",
+                          "skewkins.c"):
         yield tmp_path
 
 

@@ -119,7 +119,10 @@ def test_an_unreadable_file_is_named(tmp_path):
         read_motion_ini(str(tmp_path / "nothing.ini"))
 
 
-def test_configure_ini_reaches_motmod(hal, tmp_path):
+@pytest.fixture
+def motion(hal) -> Motion:
+    """The client of a two-joint motmod (trivkins x y, homemod, tpmod) in
+    the servo thread."""
     hal.loadrt("trivkins", "coordinates=xy")
     hal.loadrt("homemod")
     hal.loadrt("tpmod")
@@ -127,6 +130,11 @@ def test_configure_ini_reaches_motmod(hal, tmp_path):
     hal.addf("motion-command-handler", "servo-thread")
     hal.addf("motion-controller", "servo-thread")
     m = Motion.connect(hal)
+    return m
+
+
+def test_configure_ini_reaches_motmod(motion, tmp_path):
+    m = motion
     m.configure_ini(write(tmp_path, GOOD))
     s = m.status()
     j0, j1 = s.joints[:2]
@@ -136,14 +144,8 @@ def test_configure_ini_reaches_motmod(hal, tmp_path):
     assert (j1.vel_limit, j1.backlash) == (10, 0.02)
 
 
-def test_nothing_is_sent_when_a_late_key_is_bad(hal, tmp_path):
-    hal.loadrt("trivkins", "coordinates=xy")
-    hal.loadrt("homemod")
-    hal.loadrt("tpmod")
-    hal.loadrt("motmod", "num_joints=2")
-    hal.addf("motion-command-handler", "servo-thread")
-    hal.addf("motion-controller", "servo-thread")
-    m = Motion.connect(hal)
+def test_nothing_is_sent_when_a_late_key_is_bad(motion, tmp_path):
+    m = motion
     before = m.status().joints[0].vel_limit
     path = write(tmp_path, GOOD.replace("BACKLASH = 0.02", "BACKLASH = x"))
     with pytest.raises(MotionIniError):

@@ -445,13 +445,7 @@ def test_teleop_needs_homing_with_nontrivial_kins(hal):
 
 
 def test_coord_line_with_interpolation(hal):
-    m = Machine(hal, joints=3, traj_period_nsec=4000000)
-    for j in range(3):
-        m.config_joint(j)
-    m.ok(Cmd.ENABLE)
-    m.ok(Cmd.COORD)
-    m.ok(Cmd.SET_VEL_LIMIT, vel=20.0)
-    m.ok(Cmd.SET_ACC, acc=100.0)
+    m = _coord_machine(hal, traj_period_nsec=4000000)
     st = m.send(Cmd.SET_LINE, x=3.0, y=-1.0, vel=5.0, ini_maxvel=5.0, acc=50.0,
                 id=42, motion_type=MotionType.FEED)
     assert st == (Echo.ACCEPTED, "")
