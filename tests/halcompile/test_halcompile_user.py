@@ -114,6 +114,33 @@ def test_userspace_comp_runs_until_sigterm_unload(hal, progs):
             child.wait()
 
 
+def test_programs_run_without_halcompile(hal, progs, tmp_path):
+    """The runtime of a userspace program is halsdk's (halsdk.userspace):
+    the program starts and runs with the compiler made unimportable."""
+    blocker = tmp_path / "halcompile"
+    blocker.mkdir()
+    (blocker / "__init__.py").write_text(
+        'raise ImportError("halcompile is not installed here")\n')
+    env = child_env()
+    env["PYTHONPATH"] = os.pathsep.join([str(tmp_path), env["PYTHONPATH"]])
+    with open(os.path.join(progs, "hcuser"), encoding="utf-8") as f:
+        assert "halcompile" not in f.read().split("\n", 2)[2]
+    child = subprocess.Popen([os.path.join(progs, "hcuser"), "names=solo"],
+                             cwd=progs, env=env, stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True)
+    try:
+        wait_for(lambda: ready(hal, "hcuser") or child.poll() is not None)
+        assert child.poll() is None, child.communicate()
+        hal.setp("solo.in", 2.0)
+        wait_for(lambda: hal.getp("solo.out") == 2.5)        # scale 1
+        hal.unload("hcuser")
+        assert child.wait(5) == -signal.SIGTERM
+    finally:
+        if child.poll() is None:
+            child.kill()
+            child.wait()
+
+
 def test_mainloop_return_ends_program_and_removes_comp(hal, progs):
     child = start(progs, "hcuser", "count=2")
     try:
