@@ -82,7 +82,12 @@ class Hal:
     # ------------------------------------------------------------ lifetime
 
     def close(self) -> None:
-        """Stop using the instance (the host also removes it)."""
+        """Stop using the instance (the host also removes it).
+
+        Stop this process's other threads' use of the instance first: a
+        call still running in another thread when the last user closes
+        it is not guarded against the segment going away.
+        """
         if not self._closed:
             self._closed = True
             instance.release(self._conn)

@@ -291,7 +291,8 @@ def test_no_deadlock_between_gil_mutex_and_python_functions(tmp_path):
                 _core.find("signal", "nothing")
                 c = halsdk.component("churn")
                 c.exit()
-        threading.Thread(target=busy, daemon=True).start()
+        churn = threading.Thread(target=busy, daemon=True)
+        churn.start()
         for k in range(40):
             h.newthread("t", 200_000)
             h.add_python_function(f"f{k}", lambda p: None, thread="t")
@@ -299,6 +300,9 @@ def test_no_deadlock_between_gil_mutex_and_python_functions(tmp_path):
             time.sleep(0.005)
             h.delthread("t")
         stop = True
+        # the churn ends before the instance goes: closing it under a
+        # thread still in a call is not guarded (Hal.close says so)
+        churn.join(10)
         print("done")
         h.close()
     """)
