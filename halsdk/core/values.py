@@ -10,7 +10,7 @@ integers, hex floats, the bit words ``1``/``0``/``TRUE``/``FALSE``).
 from __future__ import annotations
 
 import re
-from typing import Any, Union, cast
+from typing import Any, Optional, Union, cast
 
 from halsdk.core import _core
 from halsdk.core.errors import InvalidError, Rule
@@ -18,10 +18,42 @@ from halsdk.core.types import INT_RANGES, HalType
 
 Value = Union[bool, int, float]
 
-_FLOAT = re.compile(r"\s*[-+]?(\d+\.?\d*([eE][-+]?\d+)?|\.\d+([eE][-+]?\d+)?"
-                    r"|inf|infinity|nan)\s*$", re.IGNORECASE)
-_HEX_FLOAT = re.compile(r"\s*[-+]?0[xX][0-9a-fA-F]*\.?[0-9a-fA-F]*"
-                        r"([pP][-+]?\d+)?\s*$")
+_DEC = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?\Z")
+_HEX = re.compile(r"[+-]?0[xX]([0-9a-fA-F]+\.?[0-9a-fA-F]*|\.[0-9a-fA-F]+)"
+                  r"([pP][+-]?\d+)?\Z")
+_SPECIAL = re.compile(r"([+-]?)(inf|infinity|nan|nan\([0-9A-Za-z_]*\))\Z",
+                      re.IGNORECASE)
+
+
+def c_float(word: str) -> Optional[float]:
+    """A whole word as C's ``strtod`` reads it (decimal, ``0x`` hex
+    floats, ``inf``/``infinity``/``nan``/``nan(...)`` in any case), or
+    None when it is not all a number."""
+    if _DEC.match(word):
+        return float(word)
+    if _HEX.match(word):
+        return float.fromhex(word)
+    m = _SPECIAL.match(word)
+    if m:
+        value = float("nan") if m.group(2).lower().startswith("nan") \
+            else float("inf")
+        return -value if m.group(1) == "-" else value
+    return None
+
+
+def c_wrap(htype: int, v: int) -> int:
+    """An integer as C gives it to a variable of an integer HAL type:
+    saturated as ``strtol``/``strtoul`` do (a minus sign negates an
+    unsigned one modulo 2**64), then truncated to the type's width."""
+    t = HalType(htype)
+    if t in (HalType.S32, HalType.S64):
+        v = max(-2**63, min(2**63 - 1, v))      # strtol saturates
+        bits = 32 if t == HalType.S32 else 64
+        v &= (1 << bits) - 1                     # then C truncates
+        return v - (1 << bits) if v >> (bits - 1) else v
+    if abs(v) >= 2**64:
+        v = 2**64 - 1                            # strtoul saturates
+    return v & (0xFFFFFFFF if t == HalType.U32 else 2**64 - 1)
 
 
 def c_integer(text: str) -> int:
@@ -45,11 +77,10 @@ def parse_word(htype: int, text: str, *, wrap: bool = True) -> Value:
             return False
         raise ValueError(text)
     if t == HalType.FLOAT:
-        if _FLOAT.match(text):
-            return float(text)
-        if not _HEX_FLOAT.match(text):
+        f = c_float(text.strip())
+        if f is None:
             raise ValueError(text)
-        return float.fromhex(text)
+        return f
     if text != text.rstrip():
         raise ValueError(text)          # strtol stops at a blank
     v = c_integer(text)
@@ -58,14 +89,7 @@ def parse_word(htype: int, text: str, *, wrap: bool = True) -> Value:
         if not lo <= v <= hi:
             raise ValueError(text)
         return v
-    if t in (HalType.S32, HalType.S64):
-        v = max(-2**63, min(2**63 - 1, v))      # strtol saturates
-        bits = 32 if t == HalType.S32 else 64
-        v &= (1 << bits) - 1                     # then C truncates
-        return v - (1 << bits) if v >> (bits - 1) else v
-    if abs(v) >= 2**64:
-        v = 2**64 - 1                            # strtoul saturates
-    return v & (0xFFFFFFFF if t == HalType.U32 else 2**64 - 1)
+    return c_wrap(t, v)
 
 
 def coerce(htype: int, value: Any, what: str, wrap: bool = False) -> Value:
@@ -127,7 +151,9 @@ def _bad(message: str, what: str) -> InvalidError:
 
 
 __all__ = [
+    "c_float",
     "c_integer",
+    "c_wrap",
     "parse_word",
     "coerce",
     "Value",

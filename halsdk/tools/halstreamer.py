@@ -24,15 +24,11 @@ from collections.abc import Iterable, Sequence
 from typing import IO, Optional
 
 from halsdk.tools._attach import attach, stop_on_signals
+from halsdk.values import c_float, c_wrap
 
 PROG = "halstreamer"
 POLL_S = 0.01
 
-_DEC = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?\Z")
-_HEX = re.compile(r"[+-]?0[xX]([0-9a-fA-F]+\.?[0-9a-fA-F]*|\.[0-9a-fA-F]+)"
-                  r"([pP][+-]?\d+)?\Z")
-_SPECIAL = re.compile(r"([+-]?)(inf|infinity|nan|nan\([0-9A-Za-z_]*\))\Z",
-                      re.IGNORECASE)
 _INT = re.compile(r"[+-]?\d+\Z")
 _WS = " \t\n\r\v\f"
 
@@ -44,38 +40,6 @@ class LineError(ValueError):
         super().__init__(what)
         self.field = field
         self.what = what
-
-
-def parse_float(tok: str) -> Optional[float]:
-    """``strtod`` of a whole token, or None when it is not all a number."""
-    if _DEC.match(tok):
-        return float(tok)
-    if _HEX.match(tok):
-        body = tok if "p" in tok.lower() else tok + "p0"
-        return float.fromhex(body)
-    m = _SPECIAL.match(tok)
-    if m:
-        word = m.group(2).lower()
-        value = float("nan") if word.startswith("nan") else float("inf")
-        return -value if m.group(1) == "-" else value
-    return None
-
-
-def _c_signed(tok: str, bits: int) -> int:
-    """strtol (64-bit clamp) then a cast to a signed ``bits`` integer."""
-    v = max(-(1 << 63), min((1 << 63) - 1, int(tok, 10)))
-    v &= (1 << bits) - 1
-    return v - (1 << bits) if v >> (bits - 1) else v
-
-
-def _c_unsigned(tok: str, bits: int) -> int:
-    """strtoul (a minus sign negates modulo 2**64; overflow clamps to
-    ULONG_MAX) then a cast to an unsigned ``bits`` integer."""
-    v = int(tok, 10)
-    top = (1 << 64) - 1
-    if abs(v) > top:
-        v = top
-    return v & top & ((1 << bits) - 1)
 
 
 def parse_line(line: str, types: Sequence[int]) -> list:
@@ -95,7 +59,7 @@ def parse_line(line: str, types: Sequence[int]) -> list:
         tok = line[pos:stop]
         pos = stop
         if t == HalType.FLOAT:
-            v = parse_float(tok)
+            v = c_float(tok)
             if v is None:
                 raise LineError(i, "bad character")
             values.append(v)
@@ -109,14 +73,7 @@ def parse_line(line: str, types: Sequence[int]) -> list:
             continue
         if not _INT.match(tok):
             raise LineError(i, "bad character")
-        if t == HalType.S32:
-            values.append(_c_signed(tok, 32))
-        elif t == HalType.U32:
-            values.append(_c_unsigned(tok, 32))
-        elif t == HalType.S64:
-            values.append(_c_signed(tok, 64))
-        else:
-            values.append(_c_unsigned(tok, 64))
+        values.append(c_wrap(t, int(tok, 10)))    # strtol(tok, 10)
     return values
 
 
