@@ -103,19 +103,29 @@ static int fail_exists(int kind, const char *name, const char *fmt)
                     name, NULL, NULL);
 }
 
-/* the two objects a configuration change names, found with the lock
-   held: 0, or the refusal (locked against configuration, either one
-   missing), in that order */
+/* the object a configuration change names, found with the lock held:
+   0, or the refusal (locked against configuration, then missing) */
+static int find_one_for_config(int kind, const char *name, void **found,
+                               const char *locked_fmt)
+{
+    *found = hal_find(kind, name);
+    if (hal_map.hdr->lock & HAL_LOCK_CONFIG)
+        return fail_locked(kind, name, locked_fmt);
+    if (!*found)
+        return fail_not_found(kind, name);
+    return 0;
+}
+
+/* the same for two objects: the lock, then the first missing, then the
+   second */
 static int find_for_config(int kind_a, const char *a, void **found_a,
                            int kind_b, const char *b, void **found_b,
                            const char *locked_fmt)
 {
-    *found_a = hal_find(kind_a, a);
+    int r = find_one_for_config(kind_a, a, found_a, locked_fmt);
     *found_b = hal_find(kind_b, b);
-    if (hal_map.hdr->lock & HAL_LOCK_CONFIG)
-        return fail_locked(kind_a, a, locked_fmt);
-    if (!*found_a)
-        return fail_not_found(kind_a, a);
+    if (r)
+        return r;
     if (!*found_b)
         return fail_not_found(kind_b, b);
     return 0;
@@ -833,17 +843,12 @@ int hal_alias(int kind, const char *name, const char *alias)
         return r;
     if ((r = hal_lock()))
         return r;
-    hal_obj_t *o = hal_find(kind, name);
+    hal_obj_t *o;
     hoff_t *oldname = NULL;
-    if (hal_map.hdr->lock & HAL_LOCK_CONFIG) {
-        r = fail_locked(kind, name, "cannot alias '%s': HAL is locked "
-                        "against configuration");
+    r = find_one_for_config(kind, name, (void **)&o, "cannot alias '%s': "
+                            "HAL is locked against configuration");
+    if (r)
         goto out;
-    }
-    if (!o) {
-        r = fail_not_found(kind, name);
-        goto out;
-    }
     oldname = kind == K_PIN ? &((hal_pin_t *)o)->oldname
                             : &((hal_param_t *)o)->oldname;
     if (find_in_space(K_PIN, alias)) {
@@ -962,12 +967,9 @@ int hal_signal_delete(const char *name)
     int r = hal_lock();
     if (r)
         return r;
-    hal_sig_t *s = hal_find(K_SIG, name);
-    if (hal_map.hdr->lock & HAL_LOCK_CONFIG)
-        r = fail_locked(K_SIG, name, "signal '%s': HAL is locked against "
-                        "configuration");
-    else if (!s)
-        r = fail_not_found(K_SIG, name);
+    hal_sig_t *s;
+    r = find_one_for_config(K_SIG, name, (void **)&s, "signal '%s': HAL is "
+                            "locked against configuration");
     if (!r) {
         hoff_t so = SHMOFF(s);
         FOR_EACH(K_PIN, hal_pin_t, p)
@@ -1190,13 +1192,10 @@ int hal_unlink(const char *pin_name)
     int r = hal_lock();
     if (r)
         return r;
-    hal_pin_t *p = hal_find(K_PIN, pin_name);
-    if (hal_map.hdr->lock & HAL_LOCK_CONFIG)
-        r = fail_locked(K_PIN, pin_name, "cannot unlink '%s': HAL is locked "
-                        "against configuration");
-    else if (!p)
-        r = fail_not_found(K_PIN, pin_name);
-    else if (p->signal)
+    hal_pin_t *p;
+    r = find_one_for_config(K_PIN, pin_name, (void **)&p, "cannot unlink "
+                            "'%s': HAL is locked against configuration");
+    if (!r && p->signal)
         unlink_locked(p);
     hal_unlock();
     return r;
