@@ -29,8 +29,10 @@ import tempfile
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
-REFERENCE = os.environ.get("HALSDK_REFERENCE",
-                           "/work/shared/tools/reference")
+#: the reference tool: $HALSDK_REFERENCE, else shared/tools/reference
+#: beside the checkout (tests/data/complib -> the checkout's parent)
+REFERENCE = os.environ.get("HALSDK_REFERENCE") or str(
+    HERE.parents[3] / "shared" / "tools" / "reference")
 NOTE = "Note: Using POSIX non-realtime"
 GOLDEN = (".out", ".err", ".rc")
 LOCK = "/tmp/halsdk-reference.lock"

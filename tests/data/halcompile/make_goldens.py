@@ -1,7 +1,7 @@
 """Remake reference_generated.json: what the modules built from the C that
 the reference's halcompile generates for our C-bodied corpus files do.
 
-    cd /work/main && python tests/data/halcompile/make_goldens.py
+    python tests/data/halcompile/make_goldens.py     # from the checkout
 
 Needs the LinuxCNC reference (../shared/tools/reference, or the
 command in $HALSDK_REFERENCE).  Its realtime
