@@ -541,6 +541,24 @@ class Hal:
         that a realtime module made (NotFoundError if there is none)."""
         return _core.shmem_attach(name)
 
+    def new_shared_block(self, name: str, size: int,
+                         owner: Component) -> tuple[int, int]:
+        """Create a named shared block of ``size`` zeroed bytes owned by
+        ``owner``, a component of this process (the block is deleted with
+        it); returns ``(address, size)``.  ConflictError when the name is
+        taken."""
+        return _core.shmem_new(name, owner.id, size)
+
+    def private_socket_path(self, purpose: str) -> str:
+        """The path of a Unix socket of this instance for ``purpose``
+        (``"task"``: the machine's command channel), in the user's private
+        runtime folder (mode 0700), beside the host's request socket."""
+        if purpose not in channel.SOCKET_PURPOSES:
+            raise InvalidError(f"socket purpose {purpose!r}: one of "
+                               f"{', '.join(channel.SOCKET_PURPOSES)}")
+        return os.path.join(channel.socket_dir(),
+                            self._conn.shm.lstrip("/") + f".{purpose}.sock")
+
     def pin(self, name: str) -> _core.Pin:
         return self._need("pin", name)
 

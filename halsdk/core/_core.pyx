@@ -216,6 +216,7 @@ cdef extern from "hal_core.h" nogil:
     long long hal_stream_create(const char *name, int owner_id, int depth,
                                 const char *typestring)
     long long hal_stream_attach(const char *name)
+    long long hal_shmem_new(const char *name, int owner_id, long size)
     long long hal_shmem_attach(const char *name)
     void *hal_shmem_ptr(long long handle)
     long hal_shmem_size(long long handle)
@@ -1488,6 +1489,18 @@ def stream_create(name, int owner_id, int depth, typestring) -> Stream:
     if h < 0:
         check(<int>h)
     return stream_attach(name)
+
+
+def shmem_new(name, int owner_id, long size) -> tuple:
+    """Create a named shared block of ``size`` zeroed bytes owned by a
+    component of this process (deleted with its owner); returns
+    ``(address, size)`` in this process."""
+    need_instance()
+    cdef bytes b = enc(name)
+    cdef long long h = hal_shmem_new(b, owner_id, size)
+    if h < 0:
+        check(<int>h)
+    return <size_t>hal_shmem_ptr(h), hal_shmem_size(h)
 
 
 def shmem_attach(name) -> tuple:

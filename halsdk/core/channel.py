@@ -56,11 +56,25 @@ def socket_path(shm: str) -> str:
     return os.path.join(socket_dir(), shm.lstrip("/") + ".sock")
 
 
+#: the sockets of an instance besides the request socket:
+#: ``<instance>.<purpose>.sock`` (``Hal.private_socket_path``)
+SOCKET_PURPOSES = ("task",)
+
+
 def remove_socket(shm: str) -> None:
+    """Remove the request socket of instance ``shm`` and its other
+    sockets (:data:`SOCKET_PURPOSES`), as the host does at exit and
+    ``halrun -U`` after a crash."""
     try:
-        os.unlink(socket_path(shm))
-    except (FileNotFoundError, errors.InstanceError):
-        pass
+        path = socket_path(shm)
+    except errors.InstanceError:
+        return
+    base = path[:-len(".sock")]
+    for name in (path, *(f"{base}.{p}.sock" for p in SOCKET_PURPOSES)):
+        try:
+            os.unlink(name)
+        except FileNotFoundError:
+            pass
 
 
 class Server:
