@@ -144,6 +144,9 @@ components.append(Extension(
     "halsdk.motion._channel", sources=["halsdk/motion/_channel.pyx"],
     include_dirs=["components/motion", "halsdk/include"],
     extra_compile_args=FLAGS))
+components.append(Extension(
+    "halsdk.channels._shm", sources=["halsdk/channels/_shm.pyx"],
+    extra_compile_args=FLAGS))
 names = [e.name for e in components]
 if len(set(names)) != len(names):
     sys.exit("error: two sources in components/ make the same module")
@@ -157,7 +160,7 @@ def python_drivers() -> list:
 setup(
     packages=["halsdk", "halsdk.core", "halsdk.compat", "halsdk.demo", "halsdk.halcmd",
               "halsdk.components", "halsdk.gcode", "halsdk.machine",
-              "halsdk.motion", "halsdk.tools", "halcompile",
+              "halsdk.motion", "halsdk.tools", "halsdk.channels", "halcompile",
               "halsdk.driverkit", "halsdk.drivers",
               *python_drivers()],
     package_dir={"halsdk.components": "components",

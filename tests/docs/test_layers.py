@@ -28,7 +28,7 @@ COMPONENTS, DRIVERS, COMPILER = "components", "drivers", "halcompile"
 SUBPACKAGES = {
     "core": CORE,
     "halcmd": TOOLS, "tools": TOOLS, "compat": TOOLS, "driverkit": TOOLS,
-    "web": TOOLS,
+    "web": TOOLS, "channels": TOOLS,
     "machine": APPS, "motion": APPS, "gcode": APPS, "demo": APPS,
     "components": COMPONENTS, "drivers": DRIVERS,
 }
