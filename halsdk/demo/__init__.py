@@ -188,7 +188,6 @@ def run(out_png: Optional[str] = "demo.png", realtime: bool = False,
         # to the copy, never to the shipped file
         launcher.io.table.path = os.path.join(work, "tool.tbl")
         machine = Machine.from_launcher(launcher)
-        hal.setp("iocontrol.0.emc-enable-in", True)  # no outside E-stop
         recorder = _Recorder(hal)
         hal.add_python_function("demo-recorder", recorder,
                                 thread="servo-thread")

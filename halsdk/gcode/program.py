@@ -204,6 +204,7 @@ class Program:
         self.block_delete = block_delete
         self.max_iterations = max_iterations
         self.max_call_depth = max_call_depth
+        self._frames: list[_Frame] = []
         self._main = _Unit(text, file)
         self._files: dict[str, _Unit] = {}
 
@@ -304,6 +305,12 @@ class Program:
         return target.key(self.params, Where(line.file, line.number))
 
     # -- execution -------------------------------------------------------
+    @property
+    def call_level(self) -> int:
+        """How deep the running :meth:`blocks` is in subroutine calls (0:
+        the main program), as the reference's status ``call_level``."""
+        return len(self._frames)
+
     def blocks(self) -> Iterator[Block]:
         """The blocks in execution order (see the class docstring); ends at
         M2/M30, the closing '%' or the end of the file."""
@@ -317,6 +324,7 @@ class Program:
         unit = self._main
         index = 0
         frames: list[_Frame] = []
+        self._frames = frames
         repeats: dict[tuple[int, int], int] = {}
         counts: dict[tuple[int, int], int] = {}
         seen_code = False

@@ -65,6 +65,8 @@ class Executor(C.Canon):
         self.pos = list(motion.status().carte_pos_cmd)
         self.speed = 0.0
         self.spindle_dir = 0
+        #: the spindle override of spindle 0 (1: none)
+        self.spindle_scale = 1.0
         self.g5x_index = 1
         self.g5x_offset: tuple[float, ...] = (0.0,) * 9
         self.g92_offset: tuple[float, ...] = (0.0,) * 9
@@ -78,6 +80,16 @@ class Executor(C.Canon):
         self._last_bit = False
 
     # -- helpers -----------------------------------------------------------
+
+    @property
+    def phase(self) -> int:
+        """0 before the first command waiting; 1 once it started."""
+        return self._phase
+
+    @property
+    def until(self) -> int:
+        """The motion heartbeat a dwell or an input wait ends at."""
+        return self._until
 
     def resync(self) -> None:
         """Take the position from motion (after an abort or a jog)."""
@@ -196,12 +208,13 @@ class Executor(C.Canon):
     def _do_SpindleSpeed(self, c: C.SpindleSpeed) -> None:
         self.speed = c.rpm
         if self.spindle_dir:
-            self.motion.spindle_on(self.spindle_dir * c.rpm)
+            self.motion.spindle_on(self.spindle_dir * c.rpm *
+                                   self.spindle_scale)
 
     def _do_SpindleOn(self, c: C.SpindleOn) -> None:
         self.speed = c.rpm
         self.spindle_dir = c.direction
-        self.motion.spindle_on(c.direction * c.rpm)
+        self.motion.spindle_on(c.direction * c.rpm * self.spindle_scale)
 
     def _do_SpindleOff(self, c: C.SpindleOff) -> None:
         self.spindle_dir = 0

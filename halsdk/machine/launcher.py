@@ -18,10 +18,15 @@ What the launcher does, in order:
    INI file (:meth:`halsdk.motion.Motion.configure_ini`: [KINS], [TRAJ],
    [JOINT_n], [AXIS_L]); the I/O controller runs in ``servo-thread``;
 4. starts the realtime threads and runs ``[HAL]POSTGUI_HALFILE``;
-5. runs until SIGINT (Ctrl-C) or SIGTERM, or for ``seconds`` when given;
-6. shuts down: motion disabled, ``[HAL]SHUTDOWN`` run, threads stopped,
-   ``loadusr`` programs still running ended (SIGTERM, then SIGKILL after
-   5 s), every module unloaded and the instance removed.
+5. when motion is loaded, hosts the task controller on a thread of its
+   own (:class:`halsdk.machine.runner.TaskRunner`): other processes
+   operate the machine through its command, status and error channels
+   (``import linuxcnc``, :func:`halsdk.machine.connect`, ``halsdk ctl``);
+   then runs until SIGINT (Ctrl-C) or SIGTERM, or for ``seconds``;
+6. shuts down: the task stopped (clients are told), motion disabled,
+   ``[HAL]SHUTDOWN`` run, threads stopped, ``loadusr`` programs still
+   running ended (SIGTERM, then SIGKILL after 5 s), every module unloaded
+   and the instance removed.
 
 The HAL files run in the INI file's folder, as LinuxCNC runs them: a
 relative path given to ``source`` or to a ``loadusr`` program (its
@@ -157,6 +162,33 @@ class Launcher:
         self.motion = Motion.connect(self.hal, timeout=5.0)
         self.motion.configure_ini(self.ini.path)
 
+    def controller_parts(self, io: Any = None, thread: str = "servo-thread"
+                         ) -> tuple[Any, Any, Any, str]:
+        """``(hal, motion, io, units)`` for the task controller of this
+        machine: the I/O controller made from [EMCIO] (or a new one with
+        an empty tool table, its poll in ``thread``) and the length unit
+        of [TRAJ]LINEAR_UNITS."""
+        from halsdk.machine import IoControl, MachineError, ToolTable
+        ini = self.ini
+        if self.motion is None:
+            raise MachineError(f"{ini.path}: the HAL files load no motion "
+                               "module (motmod)")
+        if io is None and self.io is not None:
+            io = self.io                # made before the HAL files ran
+        if io is None:
+            name = ini.get("EMCIO", "TOOL_TABLE")
+            random = str(ini.get("EMCIO", "RANDOM_TOOLCHANGER") or "0"
+                         ).strip() not in ("0", "")
+            table = ToolTable(random=random)
+            if name:
+                table = ToolTable.load(_path(ini, name), random=random)
+            io = IoControl(table)
+            io.attach(self.hal, thread)
+            self.io = io
+        units = str(ini.get("TRAJ", "LINEAR_UNITS") or "mm").strip().lower()
+        units = "inch" if units in ("inch", "in", "imperial") else "mm"
+        return self.hal, self.motion, io, units
+
     # ------------------------------------------------------------ run
 
     def wait(self, seconds: Optional[float] = None) -> None:
@@ -197,23 +229,40 @@ class Launcher:
 
 def run(ini_path: str, seconds: Optional[float] = None,
         realtime: bool = True) -> int:
-    """``halsdk run``: start, run until a signal (or ``seconds``), shut
-    down.  Returns the exit status."""
+    """``halsdk run``: start, host the task (when the HAL files load
+    motion), run until a signal (or ``seconds``), shut down.  Returns the
+    exit status."""
+    from halsdk.machine.runner import TaskRunner
     try:
         machine = Launcher(ini_path)
         machine.start(realtime=realtime)
     except HalError as e:
         print(f"halsdk run: {e}", file=sys.stderr)
         return 1
+    runner = None
+    try:
+        if machine.motion is not None:
+            runner = TaskRunner(machine, realtime=realtime)
+            runner.start()
+    except HalError as e:
+        print(f"halsdk run: {e}", file=sys.stderr)
+        machine.shutdown()
+        return 1
     old = {s: signal.signal(s, machine.stop)
            for s in (signal.SIGINT, signal.SIGTERM)}
     try:
-        print(f"halsdk run: {ini_path}: machine running; Ctrl-C stops it",
+        what = "machine running" if runner else "HAL running (no motion: " \
+            "no task)"
+        print(f"halsdk run: {ini_path}: {what}; Ctrl-C stops it",
               file=machine.out, flush=True)
         machine.wait(seconds)
     finally:
         for s, handler in old.items():
             signal.signal(s, handler)
-        machine.shutdown()
+        try:
+            if runner is not None:
+                runner.stop()
+        finally:
+            machine.shutdown()
     print("halsdk run: stopped", file=machine.out, flush=True)
     return 0

@@ -14,7 +14,7 @@ line runs.  Every refusal raises :class:`MachineError` saying why.
 from __future__ import annotations
 
 import enum
-from typing import Any
+from typing import Any, Callable, Optional
 
 from halsdk.errors import HalError
 from halsdk.machine.iocontrol import IoState
@@ -91,7 +91,21 @@ class Task:
         self.interp_state = InterpState.IDLE
 
     def set_state(self, state: TaskState | int) -> None:
-        """Request ``state`` (the reference's ``command.state``)."""
+        """Request ``state`` (the reference's ``command.state``) and wait
+        for the I/O controller's answer to an E-stop reset."""
+        finished = self.request_state(state)
+        if finished is not None:
+            self.motion.wait_for(
+                lambda _st: self.io.state is not IoState.RESETTING,
+                what="the E-stop reset (iocontrol.0.emc-enable-in)")
+            finished()
+
+    def request_state(self, state: TaskState | int
+                      ) -> Optional[Callable[[], bool]]:
+        """Request ``state`` without waiting.  Returns None when it is
+        reached, else (E-stop reset) a function that is True once the I/O
+        controller answered and raises MachineError when the reset
+        failed."""
         state = TaskState(state)
         if state is TaskState.ESTOP:
             self.io.estop()
@@ -102,21 +116,15 @@ class Task:
                 raise MachineError("E-stop reset refused: the machine is "
                                    "on (turn it off first)")
             if self.state is TaskState.ESTOP_RESET:
-                return
+                return None
             self.io.estop_reset()
-            self.motion.wait_for(
-                lambda _st: self.io.state is not IoState.RESETTING,
-                what="the E-stop reset (iocontrol.0.emc-enable-in)")
-            if self.io.state is not IoState.ESTOP_RESET:
-                raise MachineError(
-                    "E-stop reset failed: " + (self.io.error or
-                                               "emc-enable-in stayed FALSE"))
+            return self._reset_answered
         elif state is TaskState.ON:
             if self.state is TaskState.ESTOP:
                 raise MachineError("machine on refused: the machine is in "
                                    "E-stop (reset the E-stop first)")
             if self.state is TaskState.ON:
-                return
+                return None
             self.io.machine_on()
             self.motion.enable()
             self._was_on = True
@@ -126,6 +134,16 @@ class Task:
                 self.io.machine_off()
                 self._was_on = False
                 self._disable()
+        return None
+
+    def _reset_answered(self) -> bool:
+        if self.io.state is IoState.RESETTING:
+            return False
+        if self.io.state is not IoState.ESTOP_RESET:
+            raise MachineError(
+                "E-stop reset failed: " + (self.io.error or
+                                           "emc-enable-in stayed FALSE"))
+        return True
 
     def require_on(self, what: str) -> None:
         self.sync()

@@ -161,7 +161,7 @@ def test_the_toolchanger_stand_in_acknowledges_prepare_and_change(
     io = machine.io
     io.table.path = str(tmp_path / "tool.tbl")     # never the example's
     io.estop_reset()
-    machine.hal.setp("iocontrol.0.emc-enable-in", True)
+    io.poll()                       # user-enable-out reached emc-enable-in
     io.poll()
     io.machine_on()
     io.prepare(2)
