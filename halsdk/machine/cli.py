@@ -1,4 +1,5 @@
-"""The ``halsdk`` command: ``halsdk run machine.ini`` starts a machine."""
+"""The ``halsdk`` command: ``halsdk run machine.ini`` starts a machine,
+``halsdk ctl ...`` operates it from another shell."""
 
 from __future__ import annotations
 
@@ -8,18 +9,32 @@ from typing import Optional
 
 
 def main(argv: Optional[list[str]] = None) -> int:
+    args = sys.argv[1:] if argv is None else argv
+    if args and args[0] == "ctl":
+        # its own parser: options before and after its commands
+        from halsdk.machine.ctl import main as ctl_main
+        return ctl_main(args[1:])
     p = argparse.ArgumentParser(prog="halsdk", description=__doc__)
     sub = p.add_subparsers(dest="command", required=True)
+    sub.add_parser("ctl", add_help=False,
+                   help="operate a running machine: status, estop, on, "
+                        "home, mdi, run ... (halsdk ctl --help)")
     run = sub.add_parser(
         "run", help="start a machine from its INI file; Ctrl-C stops it")
     run.add_argument("ini", help="the machine's INI file")
     run.add_argument("--seconds", type=float, default=None,
                      help="stop after this many seconds (default: run "
                           "until Ctrl-C or SIGTERM)")
-    a = p.parse_args(sys.argv[1:] if argv is None else argv)
+    run.add_argument("--stepped", action="store_true",
+                     help="do not start the realtime threads: the task "
+                          "steps the servo thread every task cycle "
+                          "(a simulation that runs the same on any "
+                          "machine load)")
+    a = p.parse_args(args)
     if a.command == "run":
         from halsdk.machine.launcher import run as run_machine
-        return run_machine(a.ini, seconds=a.seconds)
+        return run_machine(a.ini, seconds=a.seconds,
+                           realtime=not a.stepped)
     return 2
 
 
