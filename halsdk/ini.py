@@ -1,6 +1,7 @@
 """INI files of machine configurations, read as the reference reads them.
 
-``[SECTION]`` headers, ``KEY = VALUE`` lines, ``#`` and ``;`` comment
+``[SECTION]`` headers, ``KEY = VALUE`` lines (a backslash at the end of
+a line continues the value on the next one), ``#`` and ``;`` comment
 lines.  The first occurrence of a key in a section wins and keys are case
 sensitive, as in LinuxCNC (:meth:`IniFile.all` gives every value of a
 repeated key, such as ``[HAL]HALFILE``).  Each entry remembers its line,
@@ -11,6 +12,10 @@ from __future__ import annotations
 
 from collections.abc import Callable, Collection, Iterator
 from typing import Optional
+
+#: lines a value may be continued on (a backslash at the end of a line
+#: continues it), as in the reference
+MAX_EXTEND_LINES = 20
 
 
 class IniFile:
@@ -27,23 +32,36 @@ class IniFile:
         self.headers: list[tuple[str, int]] = []
         section = ""
         with open(path, encoding="utf-8", errors="replace") as f:
-            for number, raw in enumerate(f, 1):
-                line = raw.strip()
-                if not line or line[0] in "#;":
-                    continue
-                if line.startswith("[") and "]" in line:
-                    section = line[1:line.index("]")]
-                    self.section_lines.setdefault(section, number)
-                    self.headers.append((section, number))
-                    continue
-                if "=" in line:
-                    key, _, value = line.partition("=")
-                    where = (section, key.strip())
-                    self.every.setdefault(where, []).append(
-                        (value.strip(), number))
-                    if where not in self.values:
-                        self.values[where] = value.strip()
-                        self.lines[where] = number
+            rows = [row.rstrip("\n") for row in f]
+        at = 0
+        while at < len(rows):
+            raw = rows[at]
+            at += 1
+            number = at
+            line = raw.strip()
+            if not line or line[0] in "#;":
+                continue
+            if line.startswith("[") and "]" in line:
+                section = line[1:line.index("]")]
+                self.section_lines.setdefault(section, number)
+                self.headers.append((section, number))
+                continue
+            if "=" in line:
+                key, _, value = line.partition("=")
+                # a value ending in a backslash goes on on the next line
+                extended = 0
+                while raw.endswith("\\") and at < len(rows) and \
+                        extended < MAX_EXTEND_LINES:
+                    raw = rows[at]
+                    at += 1
+                    extended += 1
+                    value = value[:-1] + raw.strip()
+                where = (section, key.strip())
+                self.every.setdefault(where, []).append(
+                    (value.strip(), number))
+                if where not in self.values:
+                    self.values[where] = value.strip()
+                    self.lines[where] = number
 
     def get(self, section: str, key: str) -> Optional[str]:
         return self.values.get((section, key))

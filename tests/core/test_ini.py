@@ -37,3 +37,17 @@ def test_repeats_name_the_later_line(tmp_path):
         (8, "[AXIS_X] is given again (first at line 2)")]
     assert ini.repeats(sections=lambda s: s == "HAL") == [
         (7, "[HAL]HALFILE is given again (first at line 6)")]
+
+
+def test_a_backslash_continues_a_value(tmp_path):
+    """As the reference: a backslash that ends a line continues the value
+    on the next line (up to 20 lines); the entry keeps its first line."""
+    path = tmp_path / "m.ini"
+    path.write_text("[HALUI]\nMDI_COMMAND = G0 \\\n  X1 \\\nY2\nNEXT = 1\n"
+                    "LAST = a\\\n")
+    ini = IniFile(str(path))
+    assert ini.get("HALUI", "MDI_COMMAND") == "G0 X1 Y2"
+    assert ini.line("HALUI", "MDI_COMMAND") == 2
+    assert ini.get("HALUI", "NEXT") == "1"
+    assert ini.where("HALUI", "NEXT") == f"{path}:5"
+    assert ini.get("HALUI", "LAST") == "a\\"        # no line follows
