@@ -300,7 +300,9 @@ class TaskController:
                 if finished is not None and finished():
                     self._finish(ticket, RCS_DONE)
             except (MachineError, HalError) as e:
-                self._fail(ticket, str(e)) if ticket.error is None else \
+                if ticket.error is None:
+                    self._fail(ticket, str(e))
+                else:
                     self._finish(ticket, RCS_ERROR)
 
     # -- state and mode ----------------------------------------------------
@@ -417,14 +419,13 @@ class TaskController:
         if self.task.interp_state is InterpState.PAUSED:
             raise MachineError("MDI refused: the interpreter is PAUSED "
                                "(resume or abort first)")
-        job_ticket = t
         if self._job is not None or self._mdi_queue:
             self._mdi_queue.append((line, t))     # runs after the others
         else:
             self._start_mdi(line, t)
 
         def finished() -> bool:
-            return job_ticket.done
+            return t.done
         return finished
 
     def _start_mdi(self, line: str, t: Ticket) -> None:

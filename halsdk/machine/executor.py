@@ -93,18 +93,17 @@ class Executor(C.Canon):
 
     def resync(self) -> None:
         """Take the position from motion (after an abort or a jog)."""
-        self.pos = list(self.motion.status().carte_pos_cmd)
+        self.pos = list(self.motion.status_dict()["carte_pos_cmd"])
 
     def _rapid_vel(self) -> float:
-        v = self.motion.status().vel_limit
+        v = self.motion.status_dict()["vel_limit"]
         return v if v > 0 else 1e9
 
     def at_rest(self) -> bool:
         """The move queue is drained and nothing moves."""
-        st = self.motion.status()
-        if not st.enabled:
+        if not self.motion.status_dict()["enabled"]:
             raise ExecutorError("motion is disabled")
-        return self.motion.moves_done(st)
+        return self.motion.moves_done()
 
     def _io_idle(self) -> bool:
         if self.io.tool_state is not ToolState.IDLE:

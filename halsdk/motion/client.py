@@ -205,7 +205,12 @@ class Motion:
     def moves_done(self, status: Optional[Status] = None) -> bool:
         """Every queued move was taken and has run, and nothing moves
         (what wait_done waits for); without waiting."""
-        st = self.status() if status is None else status
+        if status is None:
+            d = self.status_dict()
+            return (d["queue_taken"] == self._ch.queue_state()[0]
+                    and d["queue_depth"] == 0 and d["in_position"]
+                    and not d["homing"])
+        st = status
         return (st.queue_taken == self._ch.queue_state()[0]
                 and st.queue_depth == 0 and st.in_position
                 and not st.homing)
@@ -229,10 +234,13 @@ class Motion:
                 raise MotionTimeout(
                     f"timeout: {what} did not happen within {timeout:g} s "
                     f"of simulated time ({self.thread} stepped)")
-            end = time.monotonic() + timeout
+            start = time.monotonic()
+            end = start + timeout
             beat = self._heartbeat()
-            while time.monotonic() < end:
-                time.sleep(0.001)
+            while (now := time.monotonic()) < end:
+                # motmod answers within a servo period or two: look often
+                # at first, then every millisecond
+                time.sleep(0.0001 if now - start < 0.005 else 0.001)
                 r = cond()
                 if r:
                     return r
