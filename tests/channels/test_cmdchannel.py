@@ -390,9 +390,12 @@ print([client.wait(s, 10) for s in serials] == [(1, None)] * 20,
 
 
 def test_clients_in_subprocesses(task: FakeTask) -> None:
+    # run in the socket's folder: from the checkout's root, "-c" would
+    # import the checkout's (unbuilt) halsdk instead of the installed one
     procs = [subprocess.Popen([sys.executable, "-c", CLIENT, task.path],
                               stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                              text=True) for _ in range(3)]
+                              text=True, cwd=os.path.dirname(task.path))
+             for _ in range(3)]
     for proc in procs:
         with ended_at_exit(proc):
             out, err = proc.communicate(timeout=BOUND * 3)
@@ -643,7 +646,8 @@ time.sleep(60)
 @pytest.mark.parametrize("cut", [2, 11])
 def test_client_killed_mid_frame(task: FakeTask, cut: int) -> None:
     proc = subprocess.Popen([sys.executable, "-c", HALF, task.path, str(cut)],
-                            stdout=subprocess.PIPE, text=True)
+                            stdout=subprocess.PIPE, text=True,
+                            cwd=os.path.dirname(task.path))
     with ended_at_exit(proc):
         assert proc.stdout is not None
         assert proc.stdout.readline() == "ready\n"

@@ -466,7 +466,8 @@ def test_the_python_examples_of_the_docs_run(machine, m):
     for code in code_blocks(repo_path("docs", "ctl.rst"), "python"):
         proc = subprocess.run([sys.executable, "-c", code],
                               env=client_env(machine.instance),
-                              capture_output=True, text=True, timeout=120)
+                              capture_output=True, text=True, timeout=120,
+                              cwd=str(machine.ini.parent))
         assert proc.returncode == 0, code + proc.stdout + proc.stderr
         out.append(proc.stdout)
     assert len(out) == 3
