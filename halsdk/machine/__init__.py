@@ -38,7 +38,7 @@ _WHERE = {
     "Machine": "api", "MachineStatus": "api",
     "ChannelError": "client", "ChannelGone": "client", "Command": "client",
     "MachineClient": "client", "MachineTimeout": "client",
-    "RemoteStatus": "client", "connect": "client",
+    "RemoteStatus": "remote_status", "connect": "client",
     "TaskController": "controller", "Ticket": "controller",
     "Executor": "executor", "ExecutorError": "executor",
     "IoControl": "iocontrol", "IoControlError": "iocontrol",

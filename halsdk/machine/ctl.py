@@ -26,14 +26,16 @@ from typing import Any, Callable, Optional, TextIO
 
 from halsdk.errors import HalError, InvalidError
 from halsdk.machine.client import (
-    AXIS_LETTERS,
     ChannelError,
     MachineClient,
     MachineTimeout,
-    RemoteStatus,
     connect,
-    exec_state_name,
     kind_name,
+)
+from halsdk.machine.remote_status import (
+    AXIS_LETTERS,
+    RemoteStatus,
+    exec_state_name,
 )
 from halsdk.machine.task import MachineError, TaskMode
 

@@ -23,6 +23,7 @@ from helpers.running_machine import client_env, mill_ini, running_machine
 
 import halsdk
 from halsdk.channels.cmdproto import RCS_DONE, RCS_ERROR, CommandError
+from halsdk.channels.shmchannel import ToolResult
 from halsdk.machine import (
     ChannelError,
     ChannelGone,
@@ -36,13 +37,12 @@ from halsdk.machine import (
     TaskState,
     connect,
 )
-from halsdk.machine.client import (
+from halsdk.machine.client import kind_name
+from halsdk.machine.remote_status import (
     RemoteAxis,
     RemoteJoint,
     RemoteSpindle,
-    ToolResult,
     exec_state_name,
-    kind_name,
 )
 from halsdk.testing import private_instance_name
 
