@@ -179,3 +179,30 @@ def test_boolean_options_refuse_other_words(tmp_path, value):
     assert proc.returncode == 1
     assert "hcboolbad.comp:3:18: option singleton takes yes or no" \
         in proc.stderr
+
+
+# ------------------------------------------ MODULE_* in the code section
+
+def test_module_info_in_the_code_section(tmp_path):
+    """MODULE_AUTHOR, MODULE_DESCRIPTION (and MODULE_LICENSE) written in
+    the code section of a comp that also declares author, description
+    and license."""
+    comp(tmp_path, "hcmodinfo", """
+        component hcmodinfo "a described component";
+        author "A. Author";
+        description "the long description";
+        pin in s32 in;
+        pin out s32 out;
+        function _;
+        license "GPL";
+        ;;
+        MODULE_AUTHOR("Someone Else");
+        MODULE_DESCRIPTION("described twice");
+        MODULE_LICENSE("GPL v2");
+        MODULE_INFO(linuxcnc, "component:hcmodinfo");
+        FUNCTION(_) { out = in + 1; }
+        """)
+    lines = build_and_run(tmp_path, ["hcmodinfo"], "loadrt hcmodinfo\n"
+                          + run_once("hcmodinfo.0", "setp hcmodinfo.0.in 41\n",
+                                     "getp hcmodinfo.0.out\n"))
+    assert lines == ["42"]
