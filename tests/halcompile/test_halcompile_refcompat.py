@@ -206,3 +206,49 @@ def test_module_info_in_the_code_section(tmp_path):
                           + run_once("hcmodinfo.0", "setp hcmodinfo.0.in 41\n",
                                      "getp hcmodinfo.0.out\n"))
     assert lines == ["42"]
+
+
+# ---------------------------------------------------------- hal_data_u
+
+def test_hal_data_u_members_for_generic_code(tmp_path):
+    """Pins made with hal_pin_new() of any type, read and written through
+    ``hal_data_u`` pointers, as generic components (a type-converting
+    mux) do: members b, s, u, f and the 64-bit ls, lu."""
+    comp(tmp_path, "hcunion", """
+        component hcunion "converts through hal_data_u";
+        pin out bit ok;
+        variable hal_data_u *g[6];
+        option extra_setup yes;
+        function _;
+        license "GPL";
+        ;;
+        static const hal_type_t types[6] = {
+            HAL_FLOAT, HAL_S32, HAL_U32, HAL_BIT, HAL_S64, HAL_U64};
+        static const char *pnames[6] = {"in", "s", "u", "b", "ls", "lu"};
+        EXTRA_SETUP() {
+            int i, r;
+            char buf[HAL_NAME_LEN + 1];
+            for (i = 0; i < 6; i++) {
+                rtapi_snprintf(buf, sizeof(buf), "%s.%s", prefix, pnames[i]);
+                r = hal_pin_new(buf, types[i], i ? HAL_OUT : HAL_IN,
+                                (void **)&g[i], comp_id);
+                if (r) return r;
+            }
+            return 0;
+        }
+        FUNCTION(_) {
+            double x = g[0]->f;
+            double m = x < 0 ? -x : x;
+            g[1]->s = (rtapi_s32)x;
+            g[2]->u = (rtapi_u32)m;
+            g[3]->b = x != 0;
+            g[4]->ls = (rtapi_s64)x * 1000000000LL;
+            g[5]->lu = (rtapi_u64)m * 1000000000ULL;
+            ok = sizeof(hal_data_u) == 8;
+        }
+        """)
+    lines = build_and_run(tmp_path, ["hcunion"], "loadrt hcunion\n" + run_once(
+        "hcunion.0", "setp hcunion.0.in -7.75\n",
+        "".join(f"getp hcunion.0.{p}\n" for p in ("s", "u", "b", "ls",
+                                                  "lu", "ok"))))
+    assert lines == ["-7", "7", "TRUE", "-7000000000", "7000000000", "TRUE"]
