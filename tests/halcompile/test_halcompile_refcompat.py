@@ -252,3 +252,48 @@ def test_hal_data_u_members_for_generic_code(tmp_path):
         "".join(f"getp hcunion.0.{p}\n" for p in ("s", "u", "b", "ls",
                                                   "lu", "ok"))))
     assert lines == ["-7", "7", "TRUE", "-7000000000", "7000000000", "TRUE"]
+
+
+# ------------------------------------------------------- rtapi_math64.h
+
+def test_rtapi_math64_divisions(tmp_path):
+    """rtapi_div_u64, rtapi_div_u64_rem, rtapi_div_s64 and
+    rtapi_div_s64_rem divide a 64-bit dividend by a 32-bit divisor (C's
+    truncation: the remainder has the dividend's sign)."""
+    comp(tmp_path, "hcdiv64", """
+        component hcdiv64 "64-bit divisions";
+        pin in u32 hi;
+        pin in u32 lo;
+        pin in u32 d;
+        pin out u64 q;
+        pin out u32 r;
+        pin out u64 q2;
+        pin out s64 sq;
+        pin out s32 sr;
+        pin out s64 sq2;
+        function _;
+        license "GPL";
+        ;;
+        #include "rtapi_math64.h"
+        FUNCTION(_) {
+            rtapi_u64 n = ((rtapi_u64)hi << 32) | lo;
+            rtapi_u32 rem;
+            rtapi_s32 srem;
+            q = rtapi_div_u64_rem(n, d, &rem);
+            r = rem;
+            q2 = rtapi_div_u64(n, d);
+            sq = rtapi_div_s64_rem(-(rtapi_s64)n, (rtapi_s32)d, &srem);
+            sr = srem;
+            sq2 = rtapi_div_s64(-(rtapi_s64)n, -(rtapi_s32)d);
+        }
+        """)
+    hi, lo, d = 3, 5, 7
+    n = (hi << 32) | lo
+    lines = build_and_run(tmp_path, ["hcdiv64"], "loadrt hcdiv64\n" + run_once(
+        "hcdiv64.0",
+        f"setp hcdiv64.0.hi {hi}\nsetp hcdiv64.0.lo {lo}\n"
+        f"setp hcdiv64.0.d {d}\n",
+        "".join(f"getp hcdiv64.0.{p}\n" for p in ("q", "r", "q2", "sq", "sr",
+                                                  "sq2"))))
+    assert lines == [str(n // d), str(n % d), str(n // d), str(-(n // d)),
+                     str(-(n % d)), str(n // d)]
