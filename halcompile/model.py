@@ -27,6 +27,9 @@ OPTIONS = {
     "homemod": "bool", "tpmod": "bool", "constructable": "bool",
     "fp": "bool", "period": "bool", "no_convenience_defines": "bool",
     "default_personality": "int", "cython": "bool",
+    # accepted for older files; as in the reference it changes nothing
+    # (a comp has a personality when a pin or param has a condition)
+    "personality": "bool",
 }
 
 #: names the generated code uses for itself

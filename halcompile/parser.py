@@ -39,6 +39,25 @@ _BOOL_WORDS = {"yes": True, "true": True, "TRUE": True, "no": False,
                "false": False, "FALSE": False}
 
 
+def _bool_value(value: object) -> Optional[bool]:
+    """A boolean option's value as the reference reads it: bare (True),
+    yes/no, true/false, TRUE/FALSE, or a number (true unless zero).
+    Other words and strings are refused (None): the reference would read
+    even ``off`` or ``"no"`` as true."""
+    if value is True:
+        return True
+    if not isinstance(value, str):
+        return None
+    if value in _BOOL_WORDS:
+        return _BOOL_WORDS[value]
+    if not _NUMBER.fullmatch(value):
+        return None
+    try:
+        return int(value, 0) != 0
+    except ValueError:
+        return float(value) != 0
+
+
 class CompError(Exception):
     """A user error in a ``.comp`` file, with its place."""
 
@@ -401,6 +420,9 @@ class _Parser:
                 raise self.error(f"option {name} needs a value")
             value = True
         elif self.at_string():
+            if kind == "bool":
+                raise self.error(f"option {name} takes yes or no (or 1 "
+                                 "or 0), not a string", vpos)
             value = self.string()
         else:
             m = (_NUMBER.match(self.text, self.pos)
@@ -410,9 +432,10 @@ class _Parser:
             self.pos = m.end()
             value = m.group(0)
         if kind == "bool":
-            if value not in _BOOL_WORDS and value is not True:
-                raise self.error(f"option {name} takes yes or no", vpos)
-            value = True if value is True else _BOOL_WORDS[str(value)]
+            value = _bool_value(value)
+            if value is None:
+                raise self.error(f"option {name} takes yes or no (or 1 "
+                                 "or 0)", vpos)
         elif kind == "int":
             if not isinstance(value, str) or not _INT.fullmatch(value):
                 raise self.error(f"option {name} takes an integer", vpos)

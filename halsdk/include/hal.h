@@ -52,6 +52,18 @@ typedef enum {
     HAL_RW = HALSDK_RW
 } hal_param_dir_t;
 
+/* any HAL value: generic code reads a pin through a pointer to this
+   union with the member of the pin's type (member names as LinuxCNC's;
+   ls and lu for the 64-bit types, which the reference 2.9 lacks) */
+typedef union {
+    hal_bit_t b;
+    hal_s32_t s;
+    hal_u32_t u;
+    hal_float_t f;
+    hal_s64_t ls;
+    hal_u64_t lu;
+} hal_data_u;
+
 #define HAL_LOCK_NONE 0
 #define HAL_LOCK_LOAD 1
 #define HAL_LOCK_CONFIG 2

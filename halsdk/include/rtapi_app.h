@@ -33,12 +33,17 @@ void rtapi_app_exit(void);
 #define RTAPI_MP_ARRAY_LONG(var, num, desc) HALSDK_MP_(var, 'L', num, desc)
 #define RTAPI_MP_ARRAY_STRING(var, num, desc) HALSDK_MP_(var, 'S', num, desc)
 
-#define MODULE_LICENSE(s) \
-    __attribute__((used)) static const char halsdk_license[] = s
-#define MODULE_AUTHOR(s) \
-    __attribute__((used)) static const char halsdk_author[] = s
-#define MODULE_DESCRIPTION(s) \
-    __attribute__((used)) static const char halsdk_description[] = s
+/* module information: each use makes its own (unused) string, so a
+   comp may repeat in its code section what halcompile writes for its
+   author, description and license declarations */
+#define HALSDK_CAT2_(a, b) a##b
+#define HALSDK_CAT_(a, b) HALSDK_CAT2_(a, b)
+#define HALSDK_MODINFO_(tag, s)                                           \
+    __attribute__((used)) static const char                               \
+        HALSDK_CAT_(halsdk_##tag##_, __COUNTER__)[] = s
+#define MODULE_LICENSE(s) HALSDK_MODINFO_(license, s)
+#define MODULE_AUTHOR(s) HALSDK_MODINFO_(author, s)
+#define MODULE_DESCRIPTION(s) HALSDK_MODINFO_(description, s)
 #define MODULE_INFO(tag, s)
 /* offer sym (a function or variable of this module) to the modules
    loaded after it; they find it with halsdk_symbol_find("sym") */

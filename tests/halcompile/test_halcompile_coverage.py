@@ -108,6 +108,8 @@ UNSUPPORTED_OPTIONS = {
     "period": "not in the 2.9 manual; accepted and ignored",
     "no_convenience_defines": "not in the 2.9 manual",
     "constructable": "not in the 2.9 manual (newinst of comps comes later)",
+    "personality": "an older spelling that changes nothing (as in the "
+                   "reference); test_halcompile_refcompat.py compiles it",
     "modparam long": "not in the manual's grammar (RTAPI_MP_LONG in the "
                      "code section is covered)",
 }
