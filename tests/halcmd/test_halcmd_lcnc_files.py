@@ -1,0 +1,66 @@
+"""Existing LinuxCNC HAL files run unchanged (issue 18, halcmd part):
+``loadrt threads`` and its defaults, quoted module parameters, quotes in
+``loadusr`` words and INI values, and Python programs that ``import hal``
+started by ``halrun``.
+
+Every ``tests/data/halfiles_lcnc/NAME.hal`` that has a ``NAME.out`` runs
+with our ``halrun -f`` and is compared with the reference's output
+(normalized as in ``tests/golden/test_halcmd_golden.py``); ``NAME.rc``
+holds the reference's exit status.  To make a golden: copy ``NAME.hal``,
+``NAME.ini`` and the folder's ``*.py`` to an empty folder and there run
+``.../reference halrun OPTIONS -f NAME.hal > NAME.out 2>&1; echo $? >
+NAME.rc``, with the OPTIONS of the file's ``# options:`` first line.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+
+import pytest
+from helpers import data_path
+from helpers.halrun import normalize, run_cli, shm_left
+
+FILES = data_path("halfiles_lcnc")
+GOLDENS = sorted(p for p in FILES.glob("*.hal")
+                 if p.with_suffix(".out").exists())
+
+
+def _options(hal_file: Path) -> list[str]:
+    first = hal_file.read_text().splitlines()[:1]
+    if first and first[0].startswith("# options:"):
+        return first[0].split(":", 1)[1].split()
+    return []
+
+
+def _env(name: str) -> dict:
+    """Its own instance, and this Python first on PATH: the files start
+    ``python3``, which must be the Python that has this halsdk."""
+    env = dict(os.environ)
+    env["HALSDK_INSTANCE"] = f"h1-{os.getpid()}-{name}"
+    env["PATH"] = os.path.dirname(sys.executable) + os.pathsep + env["PATH"]
+    return env
+
+
+def _halrun(hal_file: Path, tmp_path: Path, env: dict):
+    for extra in FILES.iterdir():
+        if extra.suffix == ".py" or extra.name.startswith(hal_file.stem + "."):
+            (tmp_path / extra.name).write_bytes(extra.read_bytes())
+    return run_cli(["halrun", *_options(hal_file), "-f", hal_file.name],
+                   tmp_path, env)
+
+
+def test_the_files_are_there():
+    assert len(GOLDENS) >= 7
+
+
+@pytest.mark.parametrize("hal_file", GOLDENS, ids=lambda p: p.stem)
+def test_as_the_reference(hal_file: Path, tmp_path: Path):
+    env = _env(hal_file.stem)
+    proc = _halrun(hal_file, tmp_path, env)
+    expected = normalize(hal_file.with_suffix(".out").read_text())
+    assert normalize(proc.stdout) == expected
+    ref_rc = int(hal_file.with_suffix(".rc").read_text())
+    assert (proc.returncode == 0) == (ref_rc == 0), proc.stdout
+    assert shm_left(env) == []
