@@ -23,6 +23,7 @@ from helpers import data_path
 from helpers.halrun import normalize, run_cli, shm_left
 
 import halsdk
+import halsdk.compat
 from halsdk.hal import Hal
 
 FILES = data_path("halfiles_lcnc")
@@ -55,7 +56,7 @@ def _halrun(hal_file: Path, tmp_path: Path, env: dict):
 
 
 def test_the_files_are_there():
-    assert len(GOLDENS) >= 10
+    assert len(GOLDENS) >= 11
 
 
 @pytest.mark.parametrize("hal_file", GOLDENS, ids=lambda p: p.stem)
@@ -108,3 +109,25 @@ def test_quoted_words_through_the_api(hal: Hal):
     assert [f.name for f in hal.items("function")] == ["g-a", "g-b"]
     with pytest.raises(halsdk.HalError, match="unterminated quoted"):
         hal.loadrt("or2", 'names="x')
+
+
+def test_loadusr_programs_get_the_compat_modules(tmp_path: Path):
+    """The compat folder first on PYTHONPATH, the user's after it."""
+    (tmp_path / "pp.py").write_text(
+        "import os, sys\n"
+        "print('PP', os.environ['PYTHONPATH'], flush=True)\n")
+    (tmp_path / "pp.hal").write_text("loadusr -w python3 pp.py\n")
+    env = _env("pypath")
+    env["PYTHONPATH"] = "/nowhere/a" + os.pathsep + "/nowhere/b"
+    proc = run_cli(["halrun", "-f", "pp.hal"], tmp_path, env)
+    assert proc.returncode == 0, proc.stdout
+    first = halsdk.compat.pythonpath()
+    assert f"PP {first}:/nowhere/a:/nowhere/b" in proc.stdout.splitlines()
+    assert shm_left(env) == []
+
+
+def test_program_env_puts_compat_first_once():
+    first = halsdk.compat.pythonpath()
+    assert halsdk.compat.program_env({})["PYTHONPATH"] == first
+    env = halsdk.compat.program_env({"PYTHONPATH": f"/a:{first}:/b"})
+    assert env["PYTHONPATH"] == f"{first}:/a:/b"
