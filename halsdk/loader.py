@@ -204,15 +204,52 @@ def _convert(comp: str, pname: str, kind: str, raw: Any) -> Any:
                            f"{what}") from None
 
 
+def split_modparams(name: str, text: str) -> list[str]:
+    """The ``name=value`` items of one load-line word, as LinuxCNC's
+    insmod reads them: blanks separate items except inside double quotes,
+    and every double quote is removed (``config="b2b,f2f"`` is
+    ``config=b2b,f2f``, ``names="x y,z"`` names ``x y`` and ``z``).
+    Single quotes are ordinary characters, as in the reference."""
+    items: list[str] = []
+    cur: list[str] = []
+    started = quoted = False
+    for ch in text:
+        if ch == '"':
+            quoted = not quoted
+            started = True
+        elif ch.isspace() and not quoted:
+            if started:
+                items.append("".join(cur))
+            cur, started = [], False
+        else:
+            cur.append(ch)
+            started = True
+    if quoted:
+        raise InvalidError(f"{name}: unterminated quoted string in "
+                           f"'{text}'")
+    if started:
+        items.append("".join(cur))
+    return items
+
+
+def _quote_item(item: str) -> str:
+    """An item as a load line writes it (``key="a b"`` when it has a
+    blank), so that :func:`split_modparams` reads it back."""
+    key, sep, value = item.partition("=")
+    if any(ch.isspace() for ch in item):
+        return f'{key}{sep}"{value}"' if sep else f'"{item}"'
+    return item
+
+
 def parse_modparams(name: str, module: object, args: tuple,
                     kwargs: dict) -> dict:
     """Merge ``key=value`` words and keyword arguments, typed by the
     ``modparams`` of ``module`` (a component module, or any object with
-    that attribute)."""
+    that attribute).  Words are read by :func:`split_modparams`."""
     spec = getattr(module, "modparams", None) or {}
     given: dict[str, Any] = {}
     for word in args:
-        for item in str(word).split():
+        for item in split_modparams(name, str(word)):
             key, sep, value = item.partition("=")
             if not sep or not key:
                 raise InvalidError(f"{name}: '{item}' is not name=value")
@@ -296,8 +333,9 @@ class Registry:
             if isinstance(error, ValueError):      # a bad parameter value
                 raise InvalidError(f"{name}: {error}") from error
             raise LoadError(f"{name}: setup failed: {error}") from error
-        words = [w for a in args for w in str(a).split()]
-        words += [f"{k}={v}" for k, v in kwargs.items()]
+        words = [_quote_item(w) for a in args
+                 for w in split_modparams(name, str(a))]
+        words += [_quote_item(f"{k}={v}") for k, v in kwargs.items()]
         self.modules[name] = Loaded(name, module, new,
                                     "".join(w + " " for w in words))
         return [_core.comp_by_id(i).name for i in new]

@@ -17,8 +17,10 @@ layer, whose channels it reads).
 from __future__ import annotations
 
 import os
+from collections.abc import Mapping
+from typing import Optional
 
-__all__ = ["pythonpath"]
+__all__ = ["program_env", "pythonpath"]
 
 
 def pythonpath() -> str:
@@ -26,3 +28,18 @@ def pythonpath() -> str:
     :mod:`halsdk.compat.hal` and a ``linuxcnc`` module that stands for
     :mod:`halsdk.compat.linuxcnc` (put it on ``PYTHONPATH``)."""
     return os.path.join(os.path.dirname(os.path.abspath(__file__)), "pypath")
+
+
+def program_env(env: Optional[Mapping[str, str]] = None) -> dict[str, str]:
+    """``env`` (default: this process's environment) with
+    :func:`pythonpath` first on ``PYTHONPATH`` and the user's
+    ``PYTHONPATH`` after it: the environment ``halrun``, ``halcmd`` and
+    ``halsdk run`` give the programs they start with ``loadusr``, so that
+    a Python program written for LinuxCNC can ``import hal`` and
+    ``import linuxcnc``, as under the reference's halrun."""
+    out = dict(os.environ if env is None else env)
+    first = pythonpath()
+    rest = [p for p in out.get("PYTHONPATH", "").split(os.pathsep)
+            if p and p != first]
+    out["PYTHONPATH"] = os.pathsep.join([first, *rest])
+    return out

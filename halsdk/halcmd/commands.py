@@ -16,6 +16,7 @@ import time
 from collections.abc import Iterable
 from typing import Callable, Optional
 
+from halsdk.compat import program_env
 from halsdk.component import Component
 from halsdk.errors import HalError, Rule
 from halsdk.hal import Hal
@@ -424,9 +425,11 @@ class CommandRunner:
             raise CommandError("HAL is locked, loading of programs is not "
                                "permitted")
         try:
+            # the compat hal/linuxcnc modules importable, as the
+            # reference's halrun makes its own for the programs it starts
             child = subprocess.Popen([_program_path(prog), *args[1:]],
                                      stdin=subprocess.DEVNULL,
-                                     cwd=self.workdir)
+                                     cwd=self.workdir, env=program_env())
         except OSError as exc:
             raise CommandError(f"execv({prog}): {exc.strerror}",
                                f"program '{prog}' failed, returned 1"

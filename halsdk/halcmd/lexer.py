@@ -4,12 +4,16 @@ The rules follow the reference halcmd:
 
 * a backslash at the very end of a line joins the next line to it (the
   line number reported for errors is the one of the last physical line);
-* ``#`` starts a comment, except inside double quotes;
-* words are separated by blanks; a double-quoted string is one word and
-  keeps its quotes (the reference does the same);
+* ``#`` starts a comment, except inside double or single quotes;
 * ``$NAME`` and ``$(NAME)`` are replaced by environment variables,
   ``[SECTION]KEY`` and ``[SECTION](KEY)`` by entries of the INI file given
-  with ``-i``.
+  with ``-i``, in the whole line before it is split into words (so a
+  value with blanks makes several words unless it is quoted, and a value
+  may bring quotes of its own);
+* words are separated by blanks; a string in double or single quotes is
+  one word and keeps its quotes (the reference does the same: ``loadusr``
+  passes them on as they are, and ``loadrt`` leaves it to the module
+  loader to remove double quotes); an unterminated quote is an error.
 """
 
 from __future__ import annotations
@@ -26,7 +30,8 @@ __all__ = ["IniFile", "SubstitutionError", "logical_lines", "split_words",
 
 
 class SubstitutionError(Exception):
-    """A ``$VAR`` or ``[SECTION]KEY`` that cannot be replaced."""
+    """A line that cannot be read: a ``$VAR`` or ``[SECTION]KEY`` that
+    cannot be replaced, or an unterminated quote."""
 
 
 def logical_lines(lines: Iterable[str]) -> Iterator[tuple[int, str]]:
@@ -44,13 +49,19 @@ def logical_lines(lines: Iterable[str]) -> Iterator[tuple[int, str]]:
         yield number, pending
 
 
+_QUOTES = "\"'"
+
+
 def strip_comment(line: str) -> str:
-    """Remove a ``#`` comment that is not inside double quotes."""
-    quoted = False
+    """Remove a ``#`` comment that is not inside quotes."""
+    quote = ""
     for i, ch in enumerate(line):
-        if ch == '"':
-            quoted = not quoted
-        elif ch == "#" and not quoted:
+        if quote:
+            if ch == quote:
+                quote = ""
+        elif ch in _QUOTES:
+            quote = ch
+        elif ch == "#":
             return line[:i]
     return line
 
@@ -99,25 +110,33 @@ def substitute(word: str, ini: Optional[IniFile]) -> str:
 
 
 def split_words(line: str) -> list[str]:
-    """Split a comment-free line into words (quoted strings kept whole)."""
+    """Split a comment-free line into words (quoted strings kept whole,
+    with their quotes)."""
     words: list[str] = []
     cur: list[str] = []
-    quoted = False
+    quote = ""
     for ch in line:
-        if ch == '"':
-            quoted = not quoted
+        if quote:
             cur.append(ch)
-        elif ch.isspace() and not quoted:
+            if ch == quote:
+                quote = ""
+        elif ch in _QUOTES:
+            quote = ch
+            cur.append(ch)
+        elif ch.isspace():
             if cur:
                 words.append("".join(cur))
                 cur = []
         else:
             cur.append(ch)
+    if quote:
+        raise SubstitutionError("unterminated quoted string")
     if cur:
         words.append("".join(cur))
     return words
 
 
 def tokenize(line: str, ini: Optional[IniFile] = None) -> list[str]:
-    """The words of one logical line after comments and substitutions."""
-    return [substitute(w, ini) for w in split_words(strip_comment(line))]
+    """The words of one logical line: comments removed, then variables
+    substituted in the whole line, then split (as the reference does)."""
+    return split_words(substitute(strip_comment(line), ini))

@@ -83,7 +83,8 @@ class _Module:
 
     def add(self, words: list[str]) -> None:
         for word in words:
-            item, _, value = word.partition("=")
+            # read as the module loader does (double quotes removed)
+            item, _, value = word.replace('"', "").partition("=")
             if item in _FORMS:
                 if self.form is None:
                     self.form = item
@@ -110,7 +111,10 @@ class _Module:
         if self.form in ("count", "num_chan"):
             out.append(f"{self.form}={self.count}")
         elif self.form == "names":
-            out.append("names=" + ",".join(self.names))
+            names = ",".join(self.names)
+            if any(ch.isspace() for ch in names):
+                names = f'"{names}"'
+            out.append("names=" + names)
         if self.personality:
             out.append("personality=" + ",".join(self.personality))
         if self.debug is not None:

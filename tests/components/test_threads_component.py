@@ -30,16 +30,31 @@ def test_threads_stay_after_unload_and_reload_adds_more(hal):
     assert hal.thread("slow").cycles == 1 and hal.thread("servo").cycles == 10
 
 
+@pytest.mark.parametrize("words,made", [
+    ("", [("thread1", 1_000_000, True)]),
+    ("name1=a", [("a", 1_000_000, True)]),
+    ("period1=2000000 fp1=0", [("thread1", 2_000_000, False)]),
+    ("name2=b", [("thread1", 1_000_000, True)]),
+    ("period2=2000000", [("thread1", 1_000_000, True)]),
+    ("name3=c period3=3000000", [("c", 3_000_000, True),
+                                 ("thread1", 1_000_000, True)]),
+    ("period1=0", []),
+    ("name1=", []),
+])
+def test_threads_defaults_are_the_references(hal, words, made):
+    hal.loadrt("threads", words) if words else hal.loadrt("threads")
+    assert sorted((t.name, t.period, t.uses_fp)
+                  for t in hal.threads()) == made
+    assert hal.component("threads").ready
+
+
 @pytest.mark.parametrize("words,match", [
-    ("name1=a", "needs period1"),
-    ("period1=1000", "without name1"),
     ("name1=a period1=1000000 name2=b period2=1000", "fastest to slowest"),
-    ("", "no thread"),
     ("name1=a period1=10", "period"),
 ])
 def test_threads_errors_leave_nothing(hal, words, match):
     with pytest.raises(halsdk.HalError, match=match):
-        hal.loadrt("threads", words) if words else hal.loadrt("threads")
+        hal.loadrt("threads", words)
     assert hal.threads() == [] and hal.components() == []
 
 

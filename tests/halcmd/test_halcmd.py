@@ -33,8 +33,14 @@ def test_tokenize_comments_quotes_and_substitution(monkeypatch, tmp_path):
     ini_path.write_text("[AXIS_0]\nSCALE = 2.5\nSCALE = 9\n[E]\nK=v w\n")
     ini = IniFile(str(ini_path))
     assert tokenize('setp "a b" 1 # c "d"', ini) == ['setp', '"a b"', "1"]
-    assert tokenize("x$HCT_X $(HCT_X)y [AXIS_0]SCALE [E](K)", ini) == \
-        ["xval", "valy", "2.5", "v w"]
+    # substituted before the split, as in the reference: a value with a
+    # blank makes two words unless the line quotes it
+    assert tokenize("x$HCT_X $(HCT_X)y [AXIS_0]SCALE [E](K) '[E]K'",
+                    ini) == ["xval", "valy", "2.5", "v", "w", "'v w'"]
+    assert tokenize("a 'b # c' \"d\" e#f", ini) == ["a", "'b # c'", '"d"',
+                                                    "e"]
+    with pytest.raises(SubstitutionError, match="unterminated quoted"):
+        tokenize("loadrt and2 names='a,b", ini)
     with pytest.raises(SubstitutionError, match="Environment variable "
                        "'HCT_NOPE' not found."):
         tokenize("a $HCT_NOPE", ini)

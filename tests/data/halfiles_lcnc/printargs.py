@@ -1,0 +1,3 @@
+import sys
+
+print("ARGS", sys.argv[1:], flush=True)
