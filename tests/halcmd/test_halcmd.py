@@ -232,7 +232,7 @@ def test_loadusr_waits_for_ready_and_unloadusr(tmp_path):
     (tmp_path / "ucomp.py").write_text(
         "import time\nimport halsdk\n"
         "c = halsdk.component('ucomp')\nc.newpin('x', 's32', 'out')\n"
-        "c.ready()\nc['x'] = 42\ntime.sleep(60)\n")
+        "c['x'] = 42\nc.ready()\ntime.sleep(60)\n")
     (tmp_path / "u.hal").write_text(
         f"loadusr -Wn ucomp {sys.executable} ucomp.py\n"
         "list comp\ngetp ucomp.x\nunloadusr ucomp\nlist comp\n"
