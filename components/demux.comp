@@ -1,6 +1,8 @@
 component demux "Turn on one of several bits, chosen by a number and/or by selection bits";
 
-description """The personality of an instance is its number of outputs (1 to 32).
+description """The personality of an instance is its number of outputs (1 to 32); an
+instance loaded without one (no personality= given, or fewer values than
+instances) has 32, as in LinuxCNC.
 The selection is the binary number on the sel-bit pins plus sel-u32; usually
 only one of the two is connected, but a sel-bit can also shift the range that
 sel-u32 selects from. A selection past the last output selects the last
@@ -16,6 +18,7 @@ pin out bit out-##[32 : personality] "out-MM is TRUE when the selection is MM (o
 param rw bit bargraph = 0 "TRUE: turn on every output below the selected one instead of just the selected one";
 
 function _;
+option default_personality 32;
 
 see_also "select8(9), mux_generic(9)";
 author "the halsdk authors";

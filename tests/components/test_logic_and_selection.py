@@ -170,6 +170,18 @@ def test_demux_selects_clamps_and_bargraph(hal):
         assert demux_outs(hal, 1, 6) == [k < s for k in range(6)]
 
 
+def test_demux_default_personality_is_32(hal):
+    """As the reference: no personality, or a list shorter than the
+    instances, gives 32 outputs."""
+    hal.loadrt("demux", "count=3 personality=4")
+    assert [len(hal.pins(f"demux.{i}.out-*")) for i in range(3)] == \
+        [4, 32, 32]
+    thread(hal, "demux.2")
+    hal.setp("demux.2.sel-u32", 31)
+    hal.step(1)
+    assert demux_outs(hal, 2, 32) == [k == 31 for k in range(32)]
+
+
 def test_demux_too_many_outputs(hal):
     with pytest.raises(halsdk.CapacityError,
                        match="Requested size 33 exceeds max size 32"):

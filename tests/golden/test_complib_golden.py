@@ -35,8 +35,12 @@ from helpers.halrun import tools_env as _env
 
 COMPLIB = data_path("complib")
 GOLDEN = (".out", ".err", ".rc")
+#: goldens compared with a tolerance by their own test, not byte for byte
+#: (limit3-runaway: tests/components/test_limit3_properties.py)
+APPROXIMATE = {"limit3-runaway"}
 CASES = sorted(p for p in COMPLIB.glob("*.hal")
-               if p.with_suffix(".out").exists())
+               if p.with_suffix(".out").exists()
+               and p.stem not in APPROXIMATE)
 #: stderr lines of the reference's loading machinery, not of a component
 _MACHINERY = re.compile(
     r"waitpid failed|exited without becoming ready|: rtapi_app_main: |"
