@@ -70,7 +70,8 @@ from halsdk.gcode import GCodeError, Parameters, Program
 from halsdk.gcode.cutter_radius import CutterComp
 from halsdk.gcode.interp import Interpreter
 from halsdk.machine.executor import Executor
-from halsdk.machine.iocontrol import IoControl, IoState
+from halsdk.machine.iocontrol import IoControl
+from halsdk.machine.snapshot import build_snapshot
 from halsdk.machine.task import (
     InterpState,
     MachineError,
@@ -118,7 +119,6 @@ class _Job:
         self.ticket = ticket
         self.source = source
         self.error: Optional[str] = None
-        self.ended = False
 
 
 class TaskController:
@@ -972,8 +972,4 @@ class TaskController:
     def snapshot(self) -> dict:
         """The status channel's fields (:mod:`halsdk.channels.statusfields`)
         as a dict."""
-        from halsdk.machine.snapshot import build_snapshot
         return build_snapshot(self)
-
-    def io_on(self) -> bool:
-        return self.io.state is IoState.ON

@@ -118,12 +118,10 @@ class TaskRunner:
         function in the realtime thread would wait for the interpreter
         lock the task thread holds (a priority inversion of milliseconds
         every cycle)."""
-        self._poll_io = False
         for function in self.hal.functions("iocontrol.0.poll"):
             for thread in self.hal.threads():
                 if function.name in getattr(thread, "functions", ()):
                     self.hal.delf(function.name, thread.name)
-        self._poll_io = True
 
     def _refuse_second_task(self) -> None:
         try:
@@ -218,8 +216,7 @@ class TaskRunner:
     def cycle(self) -> None:
         """One task cycle (steps 2 to 4 of the module docstring)."""
         try:
-            if self._poll_io:
-                self.ctl.io.poll()
+            self.ctl.io.poll()
             self.ctl.cycle()
         except MachineError:
             pass                        # posted by the controller
