@@ -654,8 +654,8 @@ class TaskController:
         error = self._guarded_advance()
         if error is None and self.task.interp_state is InterpState.WAITING:
             try:
-                if self._guard(self.executor.pump) and \
-                        self.executor.at_rest():
+                if self._guard(lambda: self.executor.pump()
+                               and self.executor.at_rest()):
                     self.task.interp_state = InterpState.IDLE
                     self._end_job()
             except MachineError as e:

@@ -204,13 +204,18 @@ class Motion:
 
     def moves_done(self, status: Optional[Status] = None) -> bool:
         """Every queued move was taken and has run, and nothing moves
-        (what wait_done waits for); without waiting."""
+        (what wait_done waits for); without waiting.  Raises
+        :class:`QueueRejected` when motmod refused a queued record that
+        was not reported yet: a refused queue is drained, not done."""
         if status is None:
             d = self.status_dict()
+            if d["queue_err_count"] != self._q_epoch:
+                self._check_queue()
             return (d["queue_taken"] == self._ch.queue_state()[0]
                     and d["queue_depth"] == 0 and d["in_position"]
                     and not d["homing"])
         st = status
+        self._check_queue()
         return (st.queue_taken == self._ch.queue_state()[0]
                 and st.queue_depth == 0 and st.in_position
                 and not st.homing)

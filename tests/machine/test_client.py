@@ -258,6 +258,18 @@ def test_mdi_waits_and_handles(m):
     assert any("zero feed rate" in text for _, text in m.errors())
 
 
+def test_mdi_beyond_a_limit_is_always_the_waits_error(m):
+    # motmod refuses the move after the line was read; the command must
+    # end in that error, never in "done", however the cycles fall
+    for _ in range(5):
+        ready(m, TaskMode.MDI)
+        m.mdi("G21 G90 G0 X0 Y0 Z0")
+        with pytest.raises(MachineError,
+                           match="outside the axis limits"):
+            m.mdi("G0 X500", timeout=30)
+        assert m.status().position[0] == pytest.approx(0.0)
+
+
 def test_programs_open_relative_to_the_caller_and_run(m, tmp_path,
                                                       monkeypatch):
     ready(m, TaskMode.MDI)
