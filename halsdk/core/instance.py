@@ -140,10 +140,16 @@ def _attach_or_create(shm: str, create: Optional[bool],
                 "half-made; try again, or remove it with halsdk.cleanup()")
         if state == "ok":
             if not _core.pid_alive(pid, start):
+                if create is False:
+                    raise InstanceError(
+                        f"no HAL instance '{label}' is running: its host "
+                        f"(pid {pid}) is gone")
+                if _take_over(shm, label, pid):
+                    continue
                 raise InstanceError(
                     f"HAL instance '{label}' was left by a host (pid {pid}) "
-                    "that is gone; remove it with halsdk.cleanup() or "
-                    "'halrun -U'")
+                    "that is gone, and it could not be removed; remove it "
+                    "with 'halrun -U'")
             if create:
                 raise InstanceError(f"HAL instance '{label}' already has a "
                                     f"host (pid {pid})")
@@ -160,6 +166,51 @@ def _attach_or_create(shm: str, create: Optional[bool],
         return Connection(shm, host=True)
     raise InstanceError(f"HAL instance '{label}' appeared while it was "
                         "being created here; try again")
+
+
+def _take_over(shm: str, label: str, pid: int) -> bool:
+    """Remove the segment of an instance whose host is verifiably gone
+    (its pid is not running, or runs another program since the host's
+    start time), with a one-line note on stderr.  False when the name
+    does not hold that dead instance any more (another process took it
+    over first, or it is not a plain file we can remove).
+
+    Two processes may take over at once: each locks the segment file it
+    opened and removes the name only while the name still refers to that
+    locked file and the file still holds a dead host, so nobody removes
+    the instance that the other one created meanwhile."""
+    import fcntl
+    import sys
+
+    from halsdk.core import channel
+
+    path = SHM_DIR + shm
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_CLOEXEC)
+    except FileNotFoundError:
+        return True             # gone already: create it
+    except OSError:
+        return False
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        try:
+            same = os.fstat(fd).st_ino == os.stat(
+                path, follow_symlinks=False).st_ino
+        except FileNotFoundError:
+            return True         # removed by another process meanwhile
+        if same:
+            state, now_pid, start, _abi = _core.probe(shm)
+            if state != "ok" or _core.pid_alive(now_pid, start):
+                return False    # not the dead instance we saw: leave it
+            os.unlink(path)
+            channel.remove_socket(shm)
+            print(f"halsdk: HAL instance '{label}': its host (pid {pid}) "
+                  "is gone; taking the instance over", file=sys.stderr)
+        return True
+    except OSError:
+        return False
+    finally:
+        os.close(fd)
 
 
 def release(conn: Connection) -> None:

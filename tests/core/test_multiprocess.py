@@ -664,14 +664,13 @@ def test_stale_instance_is_reported_and_cleaned_up(no_connection, spawn,
         assert os.path.exists(stale_socket)
 
         assert dead_host.kill() == -signal.SIGKILL
-        for create in (False, None, True):
-            with pytest.raises(InstanceError) as err:
-                halsdk.Hal(stale, create=create)
-            msg = str(err.value)
-            assert f"'{stale}'" in msg
-            assert f"pid {dead_host.pid}" in msg
-            assert "halsdk.cleanup()" in msg
+        # a client is told; it neither attaches nor removes anything
+        with pytest.raises(InstanceError) as err:
+            halsdk.Hal(stale, create=False)
+        assert str(err.value) == (f"no HAL instance '{stale}' is running: "
+                                  f"its host (pid {dead_host.pid}) is gone")
         assert halsdk.core.instance.current() is None
+        assert os.path.exists(segment_file(stale))
 
         # cleanup() scans /dev/shm; let it see only this test's entries, so
         # that it cannot remove what concurrent test runs are creating
@@ -707,6 +706,67 @@ def test_stale_instance_is_reported_and_cleaned_up(no_connection, spawn,
         for name in (stale, live):
             remove_instance_files(name)
         os.unlink(other_file)
+
+
+@pytest.mark.parametrize("create", [True, None])
+def test_a_dead_hosts_instance_is_taken_over(no_connection, spawn, capfd,
+                                             create):
+    name = f"mp-{os.getpid()}-takeover"
+    try:
+        dead_host = spawn("host.py", name)
+        assert dead_host.readline() == f"ready {dead_host.pid}"
+        sock = channel.socket_path(halsdk.core.instance.shm_name(name))
+        old_inode = os.stat(segment_file(name)).st_ino
+        assert dead_host.kill() == -signal.SIGKILL
+        capfd.readouterr()
+        with halsdk.Hal(name, create=create) as hal:
+            assert hal.is_host
+            assert hal.info()["host_pid"] == os.getpid()
+            assert os.stat(segment_file(name)).st_ino != old_inode
+            assert os.path.exists(sock)         # this host's own socket
+            hal.newsig("fresh", "float")
+            assert [s.name for s in hal.signals()] == ["fresh"]
+        err = capfd.readouterr().err
+        assert err == (f"halsdk: HAL instance '{name}': its host (pid "
+                       f"{dead_host.pid}) is gone; taking the instance "
+                       "over\n")
+        assert not os.path.exists(segment_file(name))
+    finally:
+        remove_instance_files(name)
+
+
+def test_a_live_hosts_instance_is_never_taken_over(no_connection, spawn):
+    name = f"mp-{os.getpid()}-live-host"
+    try:
+        host = spawn("host.py", name)
+        assert host.readline() == f"ready {host.pid}"
+        inode = os.stat(segment_file(name)).st_ino
+        with pytest.raises(InstanceError,
+                           match=f"already has a host \\(pid {host.pid}\\)"):
+            halsdk.Hal(name, create=True)
+        assert os.stat(segment_file(name)).st_ino == inode
+    finally:
+        remove_instance_files(name)
+
+
+def test_racing_takeovers_make_one_host(no_connection, spawn):
+    # several processes find the same dead host at once: one removes the
+    # old segment and hosts, the others attach to that new host; nobody
+    # removes the instance another one just created
+    name = f"mp-{os.getpid()}-race"
+    try:
+        dead_host = spawn("host.py", name)
+        assert dead_host.readline() == f"ready {dead_host.pid}"
+        assert dead_host.kill() == -signal.SIGKILL
+        racers = [spawn("take_over.py", name) for _ in range(4)]
+        replies = [json.loads(r.readline(30)) for r in racers]
+        hosts = [r for r in replies if r["is_host"]]
+        assert len(hosts) == 1, replies
+        assert {r["host_pid"] for r in replies} == {hosts[0]["pid"]}
+        inode = os.stat(segment_file(name)).st_ino
+        assert {r["inode"] for r in replies} == {inode}
+    finally:
+        remove_instance_files(name)
 
 
 def test_foreign_segment_is_not_attached(no_connection):

@@ -217,6 +217,37 @@ def test_halrun_refuses_a_second_instance(hal, tmp_path):
     assert hal.info()       # the running instance is untouched
 
 
+def test_halrun_takes_over_after_a_crashed_host(tmp_path):
+    # a batch of HAL files run one after another: one host dies hard, the
+    # next halrun says so in one line and goes on, no 'halrun -U' needed
+    env = _env(tmp_path, "crash")
+    crashed = subprocess.Popen([sys.executable, "-m", "halsdk.halcmd.cli",
+                                "halrun"], cwd=tmp_path, env=env,
+                               stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                               stderr=subprocess.STDOUT, text=True)
+    try:
+        crashed.stdin.write("newsig a bit\nloadrt threads\nstart\n"
+                            "sets a 1\ngets a\n")
+        crashed.stdin.flush()
+        assert crashed.stdout.readline() == "TRUE\n"
+    finally:
+        crashed.kill()
+        crashed.wait(10)
+        crashed.stdin.close()
+        crashed.stdout.close()
+    assert _shm_left(env) != []
+    (tmp_path / "next.hal").write_text("newsig b u32\nsets b 7\ngets b\n"
+                                       "list sig\n")
+    proc = _cli(["halrun", "-f", "next.hal"], tmp_path, env)
+    assert proc.returncode == 0, proc.stdout
+    assert proc.stdout.splitlines()[0] == (
+        f"halsdk: HAL instance '{env['HALSDK_INSTANCE']}': its host (pid "
+        f"{crashed.pid}) is gone; taking the instance over")
+    # a fresh instance: the dead host's signal 'a' is not there
+    assert proc.stdout.splitlines()[1:] == ["7", "b "]
+    assert _shm_left(env) == []
+
+
 def test_missing_file_and_bad_option(tmp_path):
     env = _env(tmp_path, "opt")
     proc = _cli(["halrun", "-f", "nosuch.hal"], tmp_path, env)
