@@ -743,3 +743,101 @@ def test_rtu_over_pseudo_terminals(tmp_path, hal, pty_bridge, engine_of):
         assert hal.getp("mb2hal.ir.00.float") == 31.0
     finally:
         srv.stop()
+
+
+SINGLE_WRITES = INIT.replace("INIT_DEBUG=0", "INIT_DEBUG=1") + (
+    "[TRANSACTION_00]\n{head}MB_TX_CODE=fnct_06_write_single_register\n"
+    "FIRST_ELEMENT=20\nNELEMENTS=2\nHAL_TX_NAME=w6\n"
+    "[TRANSACTION_01]\nMB_TX_CODE=fnct_05_write_single_coil\n"
+    "FIRST_ELEMENT=30\nPIN_NAMES=a,b\nHAL_TX_NAME=w5\n"
+    "[TRANSACTION_02]\nMB_TX_CODE=fnct_06_write_single_register\n"
+    "FIRST_ELEMENT=40\nNELEMENTS=1\nHAL_TX_NAME=one\n"
+    "[TRANSACTION_03]\nMB_TX_CODE=fnct_03_read_holding_registers\n"
+    "FIRST_ELEMENT=40\nNELEMENTS=1\nHAL_TX_NAME=back\n")
+
+
+def test_halrun_single_write_of_several_elements_sends_nothing(
+        tmp_path, python_tools_first, monkeypatch):
+    """LinuxCNC's mb2hal runs fnct_05/06 with NELEMENTS>1 but never sends
+    them: each repetition counts an error, the link goes on."""
+    monkeypatch.setenv("HALSDK_INSTANCE", f"i18mb-sw-{os.getpid()}")
+    srv = sim.ServerThread(record=True).start()
+    try:
+        (tmp_path / "plc.ini").write_text(SINGLE_WRITES.format(
+            n=4, head=tcp_head(srv.port, rate=20.0, debug=1)))
+        proc = _halrun(tmp_path, "loadusr -W mb2hal config=plc.ini\n"
+                       "setp mb2hal.w6.00.int 11\nsetp mb2hal.w6.01.int 22\n"
+                       "setp mb2hal.w5.a.bit 1\nsetp mb2hal.one.00.int 33\n"
+                       "loadusr -w sleep 0.6\n"
+                       "getp mb2hal.w6.num_errors\n"
+                       "getp mb2hal.w5.num_errors\n"
+                       "getp mb2hal.one.num_errors\n"
+                       "getp mb2hal.back.00.int\nunloadusr mb2hal\n")
+    finally:
+        srv.stop()
+    out = proc.stdout.splitlines()
+    assert proc.returncode == 0, proc.stdout
+    w6, w5, one, back = out[-4:]
+    assert int(w6) >= 3 and int(w5) >= 3 and one == "0" and back == "33"
+    assert {(code, addr) for code, addr, _ in srv.requests} == {
+        (6, 40), (3, 40)}
+    assert (6, 40, [33]) in srv.requests
+    # one warning per transaction at start, naming file, line and key
+    assert ("mb2hal: warning: plc.ini:15: [TRANSACTION_00]"
+            "NELEMENTS: fnct_06_write_single_register sends at most 1 "
+            "element(s), not 2: nothing is sent and each repetition counts "
+            "an error") in out
+    assert any(line.startswith("mb2hal: warning: plc.ini:20: "
+                               "[TRANSACTION_01]PIN_NAMES: fnct_05")
+               for line in out)
+    # and the failure of each such transaction is logged once
+    assert len([line for line in out if "transaction w6: not sent" in line
+                ]) == 1
+
+
+def test_halrun_strict_refuses_what_warns(tmp_path, python_tools_first,
+                                         monkeypatch):
+    monkeypatch.setenv("HALSDK_INSTANCE", f"i18mb-st-{os.getpid()}")
+    (tmp_path / "plc.ini").write_text(SINGLE_WRITES.format(
+        n=4, head=tcp_head(free_port())))
+    proc = _halrun(tmp_path, "loadusr -W mb2hal --strict config=plc.ini\n")
+    assert proc.returncode != 0
+    lines = [line for line in proc.stdout.splitlines()
+             if line.startswith("mb2hal: ")]
+    assert lines[0] == (
+        "mb2hal: plc.ini:15: [TRANSACTION_00]NELEMENTS: "
+        "fnct_06_write_single_register sends at most 1 element(s), not 2: "
+        "nothing is sent and each repetition counts an error (refused by "
+        "--strict)")
+    assert len(lines) == 2 and "[TRANSACTION_01]PIN_NAMES" in lines[1]
+    assert "Traceback" not in proc.stdout
+
+
+def test_program_help_shows_strict(tmp_path):
+    proc = subprocess.run([sys.executable, "-m", "halsdk.drivers.mb2hal",
+                           "--help"], cwd=tmp_path, capture_output=True,
+                          text=True, timeout=30)
+    assert proc.returncode == 0
+    assert "--strict" in proc.stdout and "config=FILE.ini" in proc.stdout
+
+
+def test_program_warnings_follow_init_debug(tmp_path):
+    """INIT_DEBUG=0 (silent) hides the warnings; --strict still refuses."""
+    path = tmp_path / "odd.ini"
+    path.write_text("[MB2HAL_INIT]\nINIT_DEBUG=0\nTOTAL_TRANSACTIONS=0x\n")
+    proc = subprocess.run([sys.executable, "-m", "halsdk.drivers.mb2hal",
+                           f"config={path}"], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=30)
+    assert proc.returncode == 1
+    assert proc.stderr == (f"mb2hal: {path}:3: [MB2HAL_INIT]"
+                           "TOTAL_TRANSACTIONS: '0x' is not an integer\n")
+    path.write_text("[MB2HAL_INIT]\nINIT_DEBUG=0\nTOTAL_TRANSACTIONS=1\n"
+                    + TX + "FOO=1\n")
+    cfg = load_config(str(path))
+    assert cfg.warnings and cfg.init_debug == 0
+    proc = subprocess.run([sys.executable, "-m", "halsdk.drivers.mb2hal",
+                           "--strict", f"config={path}"], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=30)
+    assert proc.returncode == 1
+    assert proc.stderr == (f"mb2hal: {path}:11: [TRANSACTION_00]FOO: "
+                           "unknown key, ignored (refused by --strict)\n")
