@@ -32,6 +32,12 @@ def _args(argv: Sequence[str]) -> argparse.Namespace:
         prog="mb2hal", description="Modbus (TCP/RTU) to HAL component.")
     parser.add_argument("-n", "--name", help="component name (overrides "
                         "HAL_MODULE_NAME)")
+    parser.add_argument(
+        "--strict", action="store_true",
+        help="refuse the configuration when it has warnings (unknown or "
+        "repeated keys, values that are ignored or corrected, "
+        "transactions that cannot be sent ...) instead of running it "
+        "as LinuxCNC's mb2hal does")
     parser.add_argument("setting", nargs="*", help="config=FILE.ini")
     args = parser.parse_args(argv)
     args.config = None
@@ -52,10 +58,16 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     args = _args(sys.argv[1:] if argv is None else argv)
     logging.basicConfig(format="mb2hal: %(message)s", stream=sys.stderr)
     try:
-        config = load_config(args.config)
+        config = load_config(args.config, strict=args.strict)
     except ConfigError as exc:
-        print(f"mb2hal: {exc}", file=sys.stderr)
+        for text in exc.warnings:
+            print(f"mb2hal: warning: {text}", file=sys.stderr)
+        for line in str(exc).splitlines():
+            print(f"mb2hal: {line}", file=sys.stderr)
         return 1
+    if config.init_debug >= 1:
+        for text in config.warnings:
+            print(f"mb2hal: warning: {text}", file=sys.stderr)
     level = max([config.init_debug] + [t.debug for t in config.transactions])
     logging.getLogger("halsdk.mb2hal").setLevel(LEVELS[level])
     if level >= 4:

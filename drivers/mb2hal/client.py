@@ -51,6 +51,9 @@ class ModbusLink:
         from pymodbus.framer import FramerType
         link = self.link
         client: ModbusTcpClient | ModbusSerialClient
+        if link.kind == "tcp" and not 1 <= link.port <= 65535:
+            raise LinkDown(f"{link.describe()}: cannot connect: the port "
+                           "is out of range")
         if link.kind == "tcp":
             client = ModbusTcpClient(link.ip, port=link.port, timeout=timeout,
                                      retries=0)

@@ -18,6 +18,8 @@ from .config import VERSION_1_1, Config, Link, Transaction
 log = logging.getLogger("halsdk.mb2hal")
 
 DEBUG_ERR, DEBUG_OK, DEBUG_DEBUG = 1, 2, 3
+#: shortest repetition period, s, of a transaction that cannot be sent
+UNUSABLE_PERIOD = 0.01
 
 
 def pin_specs(tx: Transaction, version: int) -> list[tuple[str, str, str]]:
@@ -154,6 +156,12 @@ class LinkWorker:
     # -- one transaction -------------------------------------------------
     def transact(self, runner: TxRunner) -> None:
         tx = runner.tx
+        if tx.unusable:
+            # as the reference: nothing is sent, the repetition fails and
+            # the link stays as it is
+            self._failed(runner, f"{tx.line}: transaction {tx.name}: not "
+                         f"sent: {tx.unusable}")
+            return
         try:
             values = runner.outputs() if tx.is_write else None
             result = self.conn.execute(tx, values)
@@ -231,10 +239,13 @@ class LinkWorker:
             now = time.monotonic()
             if now < runner.next_due:
                 continue
-            if not self.conn.is_open:
+            if not self.conn.is_open and not runner.tx.unusable:
                 if not self.retry.ready(now) or not self._connect(runner):
                     break
-            runner.next_due = now + runner.period
+            period = runner.period
+            if runner.tx.unusable:      # no I/O to pace it: no busy loop
+                period = max(period, UNUSABLE_PERIOD)
+            runner.next_due = now + period
             self.transact(runner)
             ran = True
             pause = self.slowdown

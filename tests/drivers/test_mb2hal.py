@@ -377,68 +377,50 @@ def test_version_1_0_pin_names(tmp_path, hal, engine_of):
                    "plc.03.num_errors", "plc.wr.a", "plc.wr.num_errors"]
 
 
-BAD = [
-    ("", "[MB2HAL_INIT]", None, "TOTAL_TRANSACTIONS is required"),
-    ("TOTAL_TRANSACTIONS=x\n", "TOTAL_TRANSACTIONS", 1, "not an integer"),
-    ("VERSION=2.0\nTOTAL_TRANSACTIONS=1\n", "VERSION", 1, "not supported"),
-    ("TOTAL_TRANSACTIONS=2\n[TRANSACTION_00]\nLINK_TYPE=tcp\nTCP_IP=h\n"
-     "MB_SLAVE_ID=1\nFIRST_ELEMENT=0\nNELEMENTS=1\n"
-     "MB_TX_CODE=fnct_03_read_holding_registers\n", "TOTAL_TRANSACTIONS", 1,
-     "[TRANSACTION_01] is missing"),
-    ("TOTAL_TRANSACTIONS=1\n[TRANSACTION_00]\nLINK_TYPE=udp\n", "LINK_TYPE",
-     3, "not a link type"),
-    ("TOTAL_TRANSACTIONS=1\n[TRANSACTION_00]\nLINK_TYPE=tcp\nTCP_IP=h\n"
-     "MB_SLAVE_ID=1\nFIRST_ELEMENT=0\nNELEMENTS=2\nPIN_NAMES=a,b\n"
-     "MB_TX_CODE=fnct_03_read_holding_registers\n", "PIN_NAMES", 8,
-     "not both"),
-    ("TOTAL_TRANSACTIONS=1\n[TRANSACTION_00]\nLINK_TYPE=tcp\nTCP_IP=h\n"
-     "MB_SLAVE_ID=1\nFIRST_ELEMENT=0\nNELEMENTS=2\n"
-     "MB_TX_CODE=fnct_06_write_single_register\n", "NELEMENTS", 7,
-     "at most 1 element"),
-    ("TOTAL_TRANSACTIONS=1\n[TRANSACTION_00]\nLINK_TYPE=tcp\nTCP_IP=h\n"
-     "MB_SLAVE_ID=1\nFIRST_ELEMENT=0\nNELEMENTS=1\n"
-     "MB_TX_CODE=fnct_99_x\n", "MB_TX_CODE", 8, "unknown function"),
-    ("TOTAL_TRANSACTIONS=1\n[TRANSACTION_00]\nLINK_TYPE=serial\n"
-     "SERIAL_PORT=/dev/x\nSERIAL_BAUD=9600\nSERIAL_BITS=9\n", "SERIAL_BITS",
-     6, "out of range 5..8"),
-    ("TOTAL_TRANSACTIONS=1\n[TRANSACTION_00]\nLINK_TYPE=tcp\nTCP_IP=h\n"
-     "MB_SLAVE_ID=1\nFIRST_ELEMENT=0\nNELEMENTS=1\nHAL_TX_NAME=" + "n" * 29 +
-     "\nMB_TX_CODE=fnct_03_read_holding_registers\n", "HAL_TX_NAME", 8,
-     "at most 28"),
-]
-
-
 TX = ("[TRANSACTION_00]\nLINK_TYPE=tcp\nTCP_IP=h\nMB_SLAVE_ID=1\n"
       "FIRST_ELEMENT=0\nNELEMENTS=1\n"
       "MB_TX_CODE=fnct_03_read_holding_registers\n")
-BAD += [
-    ("TOTAL_TRANSACTIONS=1\nTOTAL_TRANSACTIONS=2\n", "TOTAL_TRANSACTIONS",
-     2, "is given again (first at line 2)"),
-    ("TOTAL_TRANSACTIONS=1\n[TRANSACTION_00]\nLINK_TYPE=tcp\n"
-     "TCP_PORT=15999\nTCP_PORT=70000\n", "[TRANSACTION_00]TCP_PORT", 5,
-     "is given again (first at line 5)"),
-    ("TOTAL_TRANSACTIONS=1\n" + TX + "MB_SLAVEID=3\n",
-     "[TRANSACTION_00]MB_SLAVEID", 9,
-     "unknown key (did you mean MB_SLAVE_ID?)"),
-    ("TOTAL_TRANSACTION=1\n", "[MB2HAL_INIT]TOTAL_TRANSACTION", 1,
-     "unknown key"),
-    ("TOTAL_TRANSACTIONS=1\n" + TX + TX, "[TRANSACTION_00]", 9,
-     "is given again (first at line 3)"),
-    ("TOTAL_TRANSACTIONS=1\n" + TX + "[MB2HAL_INIT]\nSLOWDOWN=1\n",
-     "[MB2HAL_INIT]", 9, "is given again (first at line 1)"),
-    ("SLOWDOWN=1e300\nTOTAL_TRANSACTIONS=1\n", "SLOWDOWN", 1,
-     "must be from 0 to 60 seconds"),
-    ("SLOWDOWN=nan\nTOTAL_TRANSACTIONS=1\n", "SLOWDOWN", 1, "must be"),
-    ("SLOWDOWN=inf\nTOTAL_TRANSACTIONS=1\n", "SLOWDOWN", 1, "must be"),
-    ("SLOWDOWN=-1\nTOTAL_TRANSACTIONS=1\n", "SLOWDOWN", 1, "must be"),
-    ("TOTAL_TRANSACTIONS=1\n" + TX + "MAX_UPDATE_RATE=nan\n",
-     "MAX_UPDATE_RATE", 9, "must be 0 (no limit) or from 1/3600"),
-    ("TOTAL_TRANSACTIONS=1\n" + TX + "MAX_UPDATE_RATE=inf\n",
-     "MAX_UPDATE_RATE", 9, "must be 0"),
-    ("TOTAL_TRANSACTIONS=1\n" + TX + "MAX_UPDATE_RATE=1e-300\n",
-     "MAX_UPDATE_RATE", 9, "must be 0"),
-    ("TOTAL_TRANSACTIONS=1\n" + TX + "MB_RESPONSE_TIMEOUT_MS=60001\n",
-     "MB_RESPONSE_TIMEOUT_MS", 9, "out of range 1..60000"),
+#: what LinuxCNC's mb2hal refuses too: (body after [MB2HAL_INIT], key,
+#: line of the key counted from the line after the header, text)
+BAD = [
+    ("", "[MB2HAL_INIT]", None, "TOTAL_TRANSACTIONS is required"),
+    ("TOTAL_TRANSACTIONS=x\n", "TOTAL_TRANSACTIONS", 1, "not an integer"),
+    ("TOTAL_TRANSACTIONS=0\n", "TOTAL_TRANSACTIONS", 1, "out of range"),
+    ("TOTAL_TRANSACTIONS=2\n" + TX, "TOTAL_TRANSACTIONS", 1,
+     "[TRANSACTION_01] is missing"),
+    ("TOTAL_TRANSACTIONS=1\n[transaction_00]\n", "TOTAL_TRANSACTIONS", 1,
+     "section names are case sensitive"),
+    ("TOTAL_TRANSACTIONS=1\n[TRANSACTION_00]\nLINK_TYPE=udp\n", "LINK_TYPE",
+     3, "'udp' is not one of tcp, serial"),
+    ("TOTAL_TRANSACTIONS=1\n" + TX.replace("fnct_03_read_holding_registers",
+                                           "fnct_99_x"),
+     "MB_TX_CODE", 8, "'fnct_99_x' is not one of"),
+    ("TOTAL_TRANSACTIONS=1\n" + TX.replace("fnct_03_read_holding_registers",
+                                           "fnct_03"),
+     "MB_TX_CODE", 8, "'fnct_03' is not one of"),
+    ("TOTAL_TRANSACTIONS=1\n[TRANSACTION_00]\nLINK_TYPE=serial\n"
+     "SERIAL_PORT=/dev/x\nSERIAL_BAUD=9600\nSERIAL_BITS=9\n", "SERIAL_BITS",
+     6, "out of range 5..8"),
+    ("TOTAL_TRANSACTIONS=1\n[TRANSACTION_00]\nLINK_TYPE=serial\n"
+     "SERIAL_PORT=/dev/x\nSERIAL_BAUD=9600\nSERIAL_BITS=8\n"
+     "SERIAL_PARITY=mark\n", "SERIAL_PARITY", 7, "'mark' is not one of"),
+    ("TOTAL_TRANSACTIONS=1\n" + TX + "HAL_TX_NAME=" + "n" * 29 + "\n",
+     "HAL_TX_NAME", 9, "longer than 28"),
+    ("TOTAL_TRANSACTIONS=1\n" + TX + "HAL_TX_NAME=a b\n", "HAL_TX_NAME", 9,
+     "a name with spaces"),
+    ("TOTAL_TRANSACTIONS=1\n" + TX.replace("NELEMENTS=1", "NELEMENTS=0"),
+     "NELEMENTS", 7, "out of range"),
+    ("TOTAL_TRANSACTIONS=1\n" + TX.replace("NELEMENTS=1", "PIN_NAMES=a,a"),
+     "PIN_NAMES", 7, "a name is repeated"),
+    ("TOTAL_TRANSACTIONS=1\n" + TX.replace("FIRST_ELEMENT=0",
+                                           "FIRST_ELEMENT=-1"),
+     "FIRST_ELEMENT", 6, "out of range"),
+    ("TOTAL_TRANSACTIONS=1\n" + TX.replace("NELEMENTS=1",
+                                           "NELEMENTS=2 # two"),
+     "[TRANSACTION_00]", 2, "NELEMENTS (or PIN_NAMES) is required"),
+    ("TOTAL_TRANSACTIONS=1\n" + TX.replace("MB_SLAVE_ID=1",
+                                           "mb_slave_id=1"),
+     "[TRANSACTION_00]", 2, "MB_SLAVE_ID is required"),
 ]
 
 
@@ -451,6 +433,156 @@ def test_bad_ini_names_file_line_and_key(tmp_path, body, key, line, text):
     msg = str(err.value)
     assert msg.startswith(f"{path}:{line + 1}: " if line else f"{path}:1: ")
     assert key in msg and text in msg
+
+
+def test_error_comes_with_the_warnings_that_explain_it(tmp_path):
+    path = tmp_path / "bad.ini"
+    path.write_text("[MB2HAL_INIT]\nTOTAL_TRANSACTIONS=1\n" +
+                    TX.replace("MB_SLAVE_ID=1", "mb_slave_id=1"))
+    with pytest.raises(ConfigError) as err:
+        load_config(str(path))
+    assert err.value.warnings == [
+        f"{path}:6: [TRANSACTION_00]mb_slave_id: unknown key, ignored "
+        "(keys are case sensitive: MB_SLAVE_ID?)"]
+
+
+OK_HEAD = "[MB2HAL_INIT]\nTOTAL_TRANSACTIONS=1\n"
+#: what LinuxCNC's mb2hal runs but looks like a mistake: accepted with a
+#: warning, refused with strict. (text after OK_HEAD, file line, key and
+#: text of the warning, a check of what is used)
+SUSPICIOUS = [
+    (TX + "MB_SLAVEID=3\n", 10, "[TRANSACTION_00]MB_SLAVEID",
+     "unknown key, ignored (did you mean MB_SLAVE_ID?)", None),
+    (TX + "DATA_TYPE=float\n", 10, "[TRANSACTION_00]DATA_TYPE",
+     "unknown key, ignored", None),
+    (TX.replace("NELEMENTS=1", "NELEMENTS=1\nNELEMENTS=3"), 9,
+     "[TRANSACTION_00]NELEMENTS", "is given again (first at line 8)",
+     lambda c: c.transactions[0].count == 1),
+    (TX + TX.replace("FIRST_ELEMENT=0", "FIRST_ELEMENT=7") +
+     "HAL_TX_NAME=x\n", 10, "[TRANSACTION_00]",
+     "is given again (first at line 3), ignored: only the first copy",
+     lambda c: (c.transactions[0].first_element, c.transactions[0].name)
+     == (0, "00")),
+    (TX + "[MB2HAL_INIT]\nSLOWDOWN=1\n", 10, "[MB2HAL_INIT]",
+     "is given again (first at line 1)", lambda c: c.slowdown == 0.0),
+    (TX + "[TRANSACTION_01]\n" + TX[17:], 10, "[TRANSACTION_01]",
+     "section not read: TOTAL_TRANSACTIONS=1",
+     lambda c: len(c.transactions) == 1),
+    ("VERSION=2.0\n" + TX, 3, "[MB2HAL_INIT]VERSION",
+     "'2.0' is not 1.0 or 1.1, read as 2.0 (1.1 used)",
+     lambda c: c.version == 1001),
+    ("VERSION=1\n" + TX, 3, "[MB2HAL_INIT]VERSION",
+     "'1' is not a version N.N, 1.0 used", lambda c: c.version == 1000),
+    ("INIT_DEBUG=9\n" + TX, 3, "[MB2HAL_INIT]INIT_DEBUG",
+     "9 is out of range 0..4, 4 used", lambda c: c.init_debug == 4),
+    ("SLOWDOWN=1e300\n" + TX, 3, "[MB2HAL_INIT]SLOWDOWN",
+     "1e+300 s is more than 60 s, 60 used", lambda c: c.slowdown == 60.0),
+    ("SLOWDOWN=nan\n" + TX, 3, "[MB2HAL_INIT]SLOWDOWN",
+     "'nan' is not a number, ignored", lambda c: c.slowdown == 0.0),
+    ("SLOWDOWN=-1\n" + TX, 3, "[MB2HAL_INIT]SLOWDOWN",
+     "-1 is negative, 0 used", lambda c: c.slowdown == 0.0),
+    (TX + "MAX_UPDATE_RATE=inf\n", 10, "MAX_UPDATE_RATE",
+     "'inf' is not a number, ignored",
+     lambda c: c.transactions[0].max_update_rate == 0.0),
+    (TX + "MAX_UPDATE_RATE=1e-9\n", 10, "MAX_UPDATE_RATE",
+     "1e-09 Hz is outside 1/3600",
+     lambda c: c.transactions[0].max_update_rate == 1e-9),
+    (TX + "MAX_UPDATE_RATE=10 # Hz\n", 10, "MAX_UPDATE_RATE",
+     "'10 # Hz' is not a number, ignored",
+     lambda c: c.transactions[0].max_update_rate == 0.0),
+    (TX + "MB_RESPONSE_TIMEOUT_MS=60001\n", 10, "MB_RESPONSE_TIMEOUT_MS",
+     "60001 is out of range 1..60000, 60000 used",
+     lambda c: c.transactions[0].response_timeout_ms == 60000),
+    (TX + "MB_RESPONSE_TIMEOUT_MS=0\n", 10, "MB_RESPONSE_TIMEOUT_MS",
+     "0 is out of range 1..60000, 500 used",
+     lambda c: c.transactions[0].response_timeout_ms == 500),
+    (TX + "MB_BYTE_TIMEOUT_MS=abc\n", 10, "MB_BYTE_TIMEOUT_MS",
+     "'abc' is not an integer, ignored",
+     lambda c: c.transactions[0].byte_timeout_ms == 500),
+    (TX + "DEBUG=-1\n", 10, "[TRANSACTION_00]DEBUG",
+     "-1 is out of range 0..4, 0 used",
+     lambda c: c.transactions[0].debug == 0),
+    (TX + "HAL_TX_NAME=\n", 10, "HAL_TX_NAME", "empty value, ignored",
+     lambda c: c.transactions[0].name == "00"),
+    (TX.replace("NELEMENTS=1", "NELEMENTS=2\nPIN_NAMES=a,b"), 9,
+     "PIN_NAMES", "NELEMENTS is given too",
+     lambda c: c.transactions[0].pin_names == ["a", "b"]),
+    (TX.replace("NELEMENTS=1", "NELEMENTS=3\nPIN_NAMES=a,b"), 9,
+     "PIN_NAMES", "the elements without a name are numbered",
+     lambda c: c.transactions[0].pin_names == ["a", "b", "02"]),
+    (TX.replace("NELEMENTS=1", "PIN_NAMES=a,,b,"), 8, "PIN_NAMES",
+     "empty names are skipped",
+     lambda c: c.transactions[0].pin_names == ["a", "b"]),
+    (TX.replace("NELEMENTS=1", "PIN_NAMES=a, b"), 8, "PIN_NAMES",
+     "spaces around the names are removed",
+     lambda c: c.transactions[0].pin_names == ["a", "b"]),
+    (TX.replace("NELEMENTS=1\nMB_TX_CODE=fnct_03_read_holding_registers",
+                "NELEMENTS=3\nMB_TX_CODE=fnct_06_write_single_register"), 8,
+     "[TRANSACTION_00]NELEMENTS", "fnct_06_write_single_register sends at "
+     "most 1 element(s), not 3: nothing is sent",
+     lambda c: c.transactions[0].unusable != ""),
+    (TX.replace("NELEMENTS=1", "NELEMENTS=126"), 8, "NELEMENTS",
+     "at most 125 element(s), not 126",
+     lambda c: c.transactions[0].unusable != ""),
+    (TX.replace("MB_SLAVE_ID=1", "MB_SLAVE_ID=256"), 6, "MB_SLAVE_ID",
+     "256 is not a device id (0..247 or 255)",
+     lambda c: c.transactions[0].unusable != ""),
+    (TX.replace("FIRST_ELEMENT=0", "FIRST_ELEMENT=65537"), 7,
+     "FIRST_ELEMENT", "address 1 is sent",
+     lambda c: c.transactions[0].first_element == 1),
+    (TX.replace("TCP_IP=h", "TCP_IP=h\nTCP_PORT=70000"), 6, "TCP_PORT",
+     "70000 is out of range 1..65535: the link cannot connect", None),
+    (TX.replace("LINK_TYPE=tcp\nTCP_IP=h", "LINK_TYPE=serial\n"
+                "SERIAL_PORT=/dev/x\nSERIAL_BAUD=9600\nSERIAL_BITS=8\n"
+                "SERIAL_PARITY=none\nSERIAL_STOP=1") +
+     TX.replace("_00", "_01").replace("LINK_TYPE=tcp\nTCP_IP=h",
+                                      "LINK_TYPE=serial\nSERIAL_BAUD=19200"),
+     15, "[TRANSACTION_01]LINK_TYPE", "serial port /dev/x is already "
+     "configured as serial /dev/x 9600 8N1: those settings are used",
+     lambda c: len(c.links) == 1),
+]
+
+
+@pytest.mark.parametrize("body,line,key,text,check", SUSPICIOUS)
+def test_suspicious_is_a_warning_and_refused_when_strict(
+        tmp_path, body, line, key, text, check):
+    path = tmp_path / "odd.ini"
+    total = 2 if "SERIAL_BAUD=19200" in body else 1
+    path.write_text(OK_HEAD.replace("=1", f"={total}") + body)
+    cfg = load_config(str(path))
+    first = cfg.warnings[0]
+    assert first.startswith(f"{path}:{line}: "), cfg.warnings
+    assert key in first and text in first, first
+    if check is not None:
+        assert check(cfg)
+    with pytest.raises(ConfigError) as err:
+        load_config(str(path), strict=True)
+    lines = str(err.value).splitlines()
+    assert lines == [w + " (refused by --strict)" for w in cfg.warnings]
+
+
+@pytest.mark.parametrize("body", [
+    TX.replace("LINK_TYPE=tcp", "LINK_TYPE=TCP").replace(
+        "fnct_03_read_holding_registers", "FNCT_03_READ_HOLDING_REGISTERS"),
+    TX.replace("MB_SLAVE_ID=1", "MB_SLAVE_ID = 1").replace(
+        "NELEMENTS=1", "\tNELEMENTS\t=\t1   ").replace("\n", "\r\n"),
+    TX.replace("NELEMENTS=1", "; a comment\n# another\nNELEMENTS=1"),
+    TX + "SERIAL_PORT=/dev/ttyS0\nSERIAL_BAUD=x\n[OTHER]\nANY=1\nANY=2\n",
+    TX + "MB_BYTE_TIMEOUT_MS=0\nHAL_TX_NAME=plc-in.a_B\n"
+    "[TRANSACTION_01]\nLINK_TYPE=tcp\nMB_TX_CODE=fnct_04_read_input_registers"
+    "\nFIRST_ELEMENT=1\nNELEMENTS=1\n",
+    TX.replace("MB_SLAVE_ID=1", "MB_SLAVE_ID=255"),
+])
+def test_what_the_reference_reads_silently_gives_no_warning(tmp_path,
+                                                           body):
+    path = tmp_path / "ok.ini"
+    total = 2 if "TRANSACTION_01" in body else 1
+    path.write_text(OK_HEAD.replace("=1", f"={total}") + body)
+    cfg = load_config(str(path), strict=True)
+    assert cfg.warnings == []
+    tx = cfg.transactions
+    assert tx[0].function == 3 and tx[0].slave_id in (1, 255)
+    assert tx[-1].link == tx[0].link
 
 
 def test_every_key_of_the_reference_example_is_known(tmp_path):
@@ -539,8 +671,8 @@ def test_program_bad_config_exits_1_with_file_line(tmp_path):
                           capture_output=True, text=True, timeout=30)
     assert proc.returncode == 1
     assert proc.stderr.strip() == (f"mb2hal: {path}:2: [MB2HAL_INIT]"
-                                   "TOTAL_TRANSACTIONS: '0' is out of range "
-                                   "1..99999")
+                                   "TOTAL_TRANSACTIONS: 0 is out of range "
+                                   "(1 or more)")
 
 
 @pytest.mark.parametrize("args,text", [
@@ -611,3 +743,101 @@ def test_rtu_over_pseudo_terminals(tmp_path, hal, pty_bridge, engine_of):
         assert hal.getp("mb2hal.ir.00.float") == 31.0
     finally:
         srv.stop()
+
+
+SINGLE_WRITES = INIT.replace("INIT_DEBUG=0", "INIT_DEBUG=1") + (
+    "[TRANSACTION_00]\n{head}MB_TX_CODE=fnct_06_write_single_register\n"
+    "FIRST_ELEMENT=20\nNELEMENTS=2\nHAL_TX_NAME=w6\n"
+    "[TRANSACTION_01]\nMB_TX_CODE=fnct_05_write_single_coil\n"
+    "FIRST_ELEMENT=30\nPIN_NAMES=a,b\nHAL_TX_NAME=w5\n"
+    "[TRANSACTION_02]\nMB_TX_CODE=fnct_06_write_single_register\n"
+    "FIRST_ELEMENT=40\nNELEMENTS=1\nHAL_TX_NAME=one\n"
+    "[TRANSACTION_03]\nMB_TX_CODE=fnct_03_read_holding_registers\n"
+    "FIRST_ELEMENT=40\nNELEMENTS=1\nHAL_TX_NAME=back\n")
+
+
+def test_halrun_single_write_of_several_elements_sends_nothing(
+        tmp_path, python_tools_first, monkeypatch):
+    """LinuxCNC's mb2hal runs fnct_05/06 with NELEMENTS>1 but never sends
+    them: each repetition counts an error, the link goes on."""
+    monkeypatch.setenv("HALSDK_INSTANCE", f"i18mb-sw-{os.getpid()}")
+    srv = sim.ServerThread(record=True).start()
+    try:
+        (tmp_path / "plc.ini").write_text(SINGLE_WRITES.format(
+            n=4, head=tcp_head(srv.port, rate=20.0, debug=1)))
+        proc = _halrun(tmp_path, "loadusr -W mb2hal config=plc.ini\n"
+                       "setp mb2hal.w6.00.int 11\nsetp mb2hal.w6.01.int 22\n"
+                       "setp mb2hal.w5.a.bit 1\nsetp mb2hal.one.00.int 33\n"
+                       "loadusr -w sleep 0.6\n"
+                       "getp mb2hal.w6.num_errors\n"
+                       "getp mb2hal.w5.num_errors\n"
+                       "getp mb2hal.one.num_errors\n"
+                       "getp mb2hal.back.00.int\nunloadusr mb2hal\n")
+    finally:
+        srv.stop()
+    out = proc.stdout.splitlines()
+    assert proc.returncode == 0, proc.stdout
+    w6, w5, one, back = out[-4:]
+    assert int(w6) >= 3 and int(w5) >= 3 and one == "0" and back == "33"
+    assert {(code, addr) for code, addr, _ in srv.requests} == {
+        (6, 40), (3, 40)}
+    assert (6, 40, [33]) in srv.requests
+    # one warning per transaction at start, naming file, line and key
+    assert ("mb2hal: warning: plc.ini:15: [TRANSACTION_00]"
+            "NELEMENTS: fnct_06_write_single_register sends at most 1 "
+            "element(s), not 2: nothing is sent and each repetition counts "
+            "an error") in out
+    assert any(line.startswith("mb2hal: warning: plc.ini:20: "
+                               "[TRANSACTION_01]PIN_NAMES: fnct_05")
+               for line in out)
+    # and the failure of each such transaction is logged once
+    assert len([line for line in out if "transaction w6: not sent" in line
+                ]) == 1
+
+
+def test_halrun_strict_refuses_what_warns(tmp_path, python_tools_first,
+                                         monkeypatch):
+    monkeypatch.setenv("HALSDK_INSTANCE", f"i18mb-st-{os.getpid()}")
+    (tmp_path / "plc.ini").write_text(SINGLE_WRITES.format(
+        n=4, head=tcp_head(free_port())))
+    proc = _halrun(tmp_path, "loadusr -W mb2hal --strict config=plc.ini\n")
+    assert proc.returncode != 0
+    lines = [line for line in proc.stdout.splitlines()
+             if line.startswith("mb2hal: ")]
+    assert lines[0] == (
+        "mb2hal: plc.ini:15: [TRANSACTION_00]NELEMENTS: "
+        "fnct_06_write_single_register sends at most 1 element(s), not 2: "
+        "nothing is sent and each repetition counts an error (refused by "
+        "--strict)")
+    assert len(lines) == 2 and "[TRANSACTION_01]PIN_NAMES" in lines[1]
+    assert "Traceback" not in proc.stdout
+
+
+def test_program_help_shows_strict(tmp_path):
+    proc = subprocess.run([sys.executable, "-m", "halsdk.drivers.mb2hal",
+                           "--help"], cwd=tmp_path, capture_output=True,
+                          text=True, timeout=30)
+    assert proc.returncode == 0
+    assert "--strict" in proc.stdout and "config=FILE.ini" in proc.stdout
+
+
+def test_program_warnings_follow_init_debug(tmp_path):
+    """INIT_DEBUG=0 (silent) hides the warnings; --strict still refuses."""
+    path = tmp_path / "odd.ini"
+    path.write_text("[MB2HAL_INIT]\nINIT_DEBUG=0\nTOTAL_TRANSACTIONS=0x\n")
+    proc = subprocess.run([sys.executable, "-m", "halsdk.drivers.mb2hal",
+                           f"config={path}"], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=30)
+    assert proc.returncode == 1
+    assert proc.stderr == (f"mb2hal: {path}:3: [MB2HAL_INIT]"
+                           "TOTAL_TRANSACTIONS: '0x' is not an integer\n")
+    path.write_text("[MB2HAL_INIT]\nINIT_DEBUG=0\nTOTAL_TRANSACTIONS=1\n"
+                    + TX + "FOO=1\n")
+    cfg = load_config(str(path))
+    assert cfg.warnings and cfg.init_debug == 0
+    proc = subprocess.run([sys.executable, "-m", "halsdk.drivers.mb2hal",
+                           "--strict", f"config={path}"], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=30)
+    assert proc.returncode == 1
+    assert proc.stderr == (f"mb2hal: {path}:11: [TRANSACTION_00]FOO: "
+                           "unknown key, ignored (refused by --strict)\n")
