@@ -100,7 +100,7 @@ class Options:
     timeout: float = DEFAULT_TIMEOUT
 
 
-def find_tests(dirs: Sequence[str]) -> list[Path]:
+def find_tests(dirs: Sequence[str]) -> list[str]:
     """The test programs under ``dirs`` (each a folder or a test file),
     sorted as ``find DIR... | sort`` sorts them."""
     found: list[str] = []
@@ -114,7 +114,7 @@ def find_tests(dirs: Sequence[str]) -> list[Path]:
             for name in TEST_NAMES:
                 if name in files:
                     found.append(os.path.join(root, name))
-    return [Path(p) for p in sorted(set(found))]
+    return sorted(set(found))
 
 
 def clean(folders: Sequence[Path]) -> None:
@@ -265,7 +265,7 @@ def _overrun(result: Path) -> bool:
     return re.search(r"^overrun$", text, re.MULTILINE) is not None
 
 
-def _judge(folder: Path, timeout: float, env: dict[str, str]
+def _judge(folder: Path, shown: str, timeout: float, env: dict[str, str]
            ) -> tuple[bool, str, str]:
     """(passed, reason, details) of a test whose run exited with 0."""
     checkresult = folder / "checkresult"
@@ -292,7 +292,7 @@ def _judge(folder: Path, timeout: float, env: dict[str, str]
         diff = difflib.unified_diff(
             want.decode(errors="replace").splitlines(True),
             got.decode(errors="replace").splitlines(True),
-            f"{folder}/expected", f"{folder}/result")
+            f"{shown}/expected", f"{shown}/result")
         text = "".join(line if line.endswith("\n")
                        else line + "\n\\ No newline at end of file\n"
                        for line in diff)
@@ -330,24 +330,27 @@ def run_tests(dirs: Sequence[str], opts: Options,
     err = sys.stderr if err is None else err
     tests = find_tests(dirs)
     if not opts.noclean:
-        clean(sorted({t.parent for t in tests}))
+        clean(sorted({Path(t).parent for t in tests}))
     summary = Summary()
-    for number, test in enumerate(tests, 1):
+    for number, path in enumerate(tests, 1):
+        # shown as find shows it (./a for a test found under .)
+        shown = os.path.dirname(path)
+        test = Path(path)
         folder = test.parent
         env = environment(number)
         why = _skipped(folder, env, opts.nosudo, opts.timeout)
         if why is not None:
-            print(f"Skipping {why} test: {folder}", file=err, flush=True)
-            summary.skipped.append(str(folder))
+            print(f"Skipping {why} test: {shown}", file=err, flush=True)
+            summary.skipped.append(shown)
             continue
         summary.run += 1
-        print(f"Running test: {folder}", file=err, flush=True)
+        print(f"Running test: {shown}", file=err, flush=True)
         out.flush()
         started = time.monotonic()
         rc: Optional[int] = 0
         for _ in range(OVERRUN_TRIES if test.name == "test.hal" else 1):
             if _ != 0:
-                print(f"--- {folder}: overrun detected in sampler, "
+                print(f"--- {shown}: overrun detected in sampler, "
                       "re-running test", file=err, flush=True)
             rc = run_program(test, env, opts.verbose, opts.timeout)
             if rc != 0 or not _overrun(folder / "result"):
@@ -359,25 +362,25 @@ def run_tests(dirs: Sequence[str], opts: Options,
         elif rc != 0:
             passed, reason = False, f"test run exited with {rc}"
         else:
-            passed, reason, details = _judge(folder, opts.timeout, env)
+            passed, reason, details = _judge(folder, shown, opts.timeout, env)
         if not passed:
             _halrun_cleanup(env)
         xfail = (folder / "xfail").exists()
         if passed and xfail:
-            summary.failed.append(str(folder))
-            print(f"*** {folder}: XPASS: Passed, but was expected to fail",
+            summary.failed.append(shown)
+            print(f"*** {shown}: XPASS: Passed, but was expected to fail",
                   file=out, flush=True)
         elif passed:
             if not opts.noclean:
                 clean([folder])
         elif xfail:
-            summary.xfailed.append(str(folder))
-            print(f"*** {folder}: XFAIL: {reason}", file=out, flush=True)
+            summary.xfailed.append(shown)
+            print(f"*** {shown}: XFAIL: {reason}", file=out, flush=True)
             if not opts.noclean:
                 clean([folder])
         else:
-            summary.failed.append(str(folder))
-            print(f"*** {folder}: FAIL: {reason} "
+            summary.failed.append(shown)
+            print(f"*** {shown}: FAIL: {reason} "
                   f"({time.monotonic() - started:.1f} s)", file=out)
             if details:
                 out.write(details if details.endswith("\n")
@@ -385,7 +388,7 @@ def run_tests(dirs: Sequence[str], opts: Options,
             if rc != 0 and not opts.verbose:
                 tail = _tail(folder / "stderr", STDERR_TAIL)
                 if tail:
-                    out.write(f"--- last lines of {folder}/stderr:\n{tail}")
+                    out.write(f"--- last lines of {shown}/stderr:\n{tail}")
                     if not tail.endswith("\n"):
                         out.write("\n")
             out.flush()
@@ -434,7 +437,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         print("halsdk runtests: --timeout must be positive", file=sys.stderr)
         return 2
     if a.clean:
-        clean(sorted({t.parent for t in find_tests(dirs)}))
+        clean(sorted({Path(t).parent for t in find_tests(dirs)}))
         return 0
     summary = run_tests(dirs, Options(noclean=a.noclean, stop=a.stop,
                                       nosudo=a.nosudo, verbose=a.verbose,
