@@ -1,5 +1,6 @@
 """The ``halsdk`` command: ``halsdk run machine.ini`` starts a machine,
-``halsdk ctl ...`` operates it from another shell."""
+``halsdk ctl ...`` operates it from another shell, ``halsdk runtests
+DIR...`` runs HAL tests written in LinuxCNC's test-folder format."""
 
 from __future__ import annotations
 
@@ -14,11 +15,18 @@ def main(argv: Optional[list[str]] = None) -> int:
         # its own parser: options before and after its commands
         from halsdk.machine.ctl import main as ctl_main
         return ctl_main(args[1:])
+    if args and args[0] == "runtests":
+        from halsdk.tools.runtests import main as runtests_main
+        return runtests_main(args[1:])
     p = argparse.ArgumentParser(prog="halsdk", description=__doc__)
     sub = p.add_subparsers(dest="command", required=True)
     sub.add_parser("ctl", add_help=False,
                    help="operate a running machine: status, estop, on, "
                         "home, mdi, run ... (halsdk ctl --help)")
+    sub.add_parser("runtests", add_help=False,
+                   help="run HAL tests in LinuxCNC's format (test.hal or "
+                        "test.sh + expected or checkresult) "
+                        "(halsdk runtests --help)")
     run = sub.add_parser(
         "run", help="start a machine from its INI file; Ctrl-C stops it")
     run.add_argument("ini", help="the machine's INI file")
