@@ -239,8 +239,8 @@ class CommandRunner:
             self.errors += 1
             self.error(str(exc))
             return False
-        if self.echo:
-            self.out(f"({self.lineno})<echo>: {strip_comment(text)}\n")
+        if self.echo:           # on stderr, as the reference's halcmd
+            self.err(f"({self.lineno})<echo>: {strip_comment(text)}\n")
         if not words:
             return True
         return self.run_words(words)
