@@ -333,8 +333,8 @@ class Registry:
             if isinstance(error, ValueError):      # a bad parameter value
                 raise InvalidError(f"{name}: {error}") from error
             raise LoadError(f"{name}: setup failed: {error}") from error
-        words = [_quote_item(w) for a in args
-                 for w in split_modparams(name, str(a))]
+        # saved as written (quotes kept), as the reference's save does
+        words = [str(a) for a in args]
         words += [_quote_item(f"{k}={v}") for k, v in kwargs.items()]
         self.modules[name] = Loaded(name, module, new,
                                     "".join(w + " " for w in words))
