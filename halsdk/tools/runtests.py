@@ -162,8 +162,8 @@ def _skipped(folder: Path, env: dict[str, str], nosudo: bool,
                                 stdout=subprocess.DEVNULL, timeout=timeout
                                 ).returncode
         except subprocess.TimeoutExpired:
-            rc = 0
-        if rc == 0:
+            rc = 1
+        if rc != 0:             # LinuxCNC's rule: a skip that succeeds runs
             return "disabled"
     control = folder / "control"
     if nosudo and control.is_file():

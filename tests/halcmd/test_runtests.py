@@ -134,10 +134,11 @@ def test_checkresult_judges_instead_of_expected(tmp_path: Path) -> None:
 def test_skip_and_xfail(tmp_path: Path) -> None:
     folder(tmp_path, "off", {**PASSING_HAL, "skip": "not on this machine\n"},
            executable=())
+    # an executable skip decides at run time: it fails to skip the test
     folder(tmp_path, "skipnow", {**PASSING_HAL,
-                                 "skip": "#!/bin/sh\nexit 0\n"})
+                                 "skip": "#!/bin/sh\nexit 1\n"})
     folder(tmp_path, "runnow", {**PASSING_HAL,
-                                "skip": "#!/bin/sh\nexit 1\n"})
+                                "skip": "#!/bin/sh\nexit 0\n"})
     folder(tmp_path, "xf", {"test.sh": "echo no\n", "expected": "yes\n",
                             "xfail": ""})
     proc = runtests(".", cwd=tmp_path)
@@ -234,11 +235,14 @@ def test_the_documented_example_runs(tmp_path: Path) -> None:
 @pytest.mark.slow
 def test_lcnc_format_folders_pass(tmp_path: Path) -> None:
     """Every folder of tests/lcnc-format passes (run on a copy, so that the
-    checkout gets no result files)."""
+    checkout gets no result files; the copy keeps the checkout's layout
+    for the example Modbus simulator the mb2hal tests start)."""
     import shutil
-    src = repo_path("tests", "lcnc-format")
-    shutil.copytree(src, tmp_path / "lcnc-format", symlinks=True)
-    proc = runtests("lcnc-format", cwd=tmp_path, timeout=1200)
+    shutil.copytree(repo_path("tests", "lcnc-format"),
+                    tmp_path / "tests" / "lcnc-format", symlinks=True)
+    shutil.copytree(repo_path("examples", "modbus"),
+                    tmp_path / "examples" / "modbus", symlinks=True)
+    proc = runtests("lcnc-format", cwd=tmp_path / "tests", timeout=1200)
     assert proc.returncode == 0, proc.stdout[-6000:]
     run, ok, failed, _xfailed, _skipped = counts(proc)
     assert failed == 0
