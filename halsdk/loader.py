@@ -102,10 +102,12 @@ def _import_file(name: str, path: str,
         spec = importlib.util.spec_from_file_location(qual, source)
         if spec is None or spec.loader is None:
             raise LoadError(f"cannot load component '{name}' from {path}")
-        module = importlib.util.module_from_spec(spec)
-        if package is not None:
-            module.__package__ = package
         try:
+            # a compiled module is mapped here: a symbol it calls that
+            # nothing provides (an API halsdk lacks) fails now, by name
+            module = importlib.util.module_from_spec(spec)
+            if package is not None:
+                module.__package__ = package
             spec.loader.exec_module(module)
         except Exception as exc:
             raise LoadError(f"component '{name}' ({path}) failed to "

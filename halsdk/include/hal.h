@@ -69,6 +69,7 @@ typedef union {
 #define HAL_LOCK_CONFIG 2
 #define HAL_LOCK_PARAMS 4
 #define HAL_LOCK_RUN 8
+#define HAL_LOCK_TUNE (HAL_LOCK_LOAD | HAL_LOCK_CONFIG)
 #define HAL_LOCK_ALL 255
 
 /* components */
@@ -87,6 +88,15 @@ static inline int hal_ready(int comp_id)
 static inline int hal_unready(int comp_id)
 {
     return HALSDK_API->comp_unready(comp_id);
+}
+static inline int hal_set_unready(int comp_id)
+{
+    return HALSDK_API->comp_unready(comp_id);
+}
+/* the name of a component (or instance) of the instance, or NULL */
+static inline char *hal_comp_name(int comp_id)
+{
+    return (char *)HALSDK_API->comp_name(comp_id);
 }
 static inline void *hal_malloc(long int size)
 {
@@ -189,6 +199,81 @@ HALSDK_PARAM_NEW_(u32, hal_u32_t, HAL_U32)
 HALSDK_PARAM_NEW_(s64, hal_s64_t, HAL_S64)
 HALSDK_PARAM_NEW_(u64, hal_u64_t, HAL_U64)
 
+/* set a param by name, as setp does: its type must match and it must
+   be writable */
+static inline int hal_param_set(const char *name, hal_type_t type,
+                                void *value_addr)
+{
+    return HALSDK_API->param_set(name, type, value_addr);
+}
+static inline int hal_param_bit_set(const char *name, int value)
+{
+    rtapi_u8 v = value != 0;
+    return HALSDK_API->param_set(name, HAL_BIT, &v);
+}
+static inline int hal_param_float_set(const char *name, double value)
+{
+    return HALSDK_API->param_set(name, HAL_FLOAT, &value);
+}
+static inline int hal_param_u32_set(const char *name, unsigned long value)
+{
+    rtapi_u32 v = (rtapi_u32)value;
+    return HALSDK_API->param_set(name, HAL_U32, &v);
+}
+static inline int hal_param_s32_set(const char *name, signed long value)
+{
+    rtapi_s32 v = (rtapi_s32)value;
+    return HALSDK_API->param_set(name, HAL_S32, &v);
+}
+
+/* where the value of a pin, signal or param is, and its type; 0, or a
+   negative errno (the reference returns -1) */
+static inline int hal_get_pin_value_by_name(const char *name,
+                                            hal_type_t *type,
+                                            hal_data_u **data,
+                                            bool *connected)
+{
+    int t, f;
+    void *d;
+    int r = HALSDK_API->value_by_name(0, name, &t, &d, &f);
+    if (r == 0) {
+        *type = (hal_type_t)t;
+        *data = (hal_data_u *)d;
+        if (connected)
+            *connected = f;
+    }
+    return r;
+}
+static inline int hal_get_signal_value_by_name(const char *name,
+                                               hal_type_t *type,
+                                               hal_data_u **data,
+                                               bool *has_writers)
+{
+    int t, f;
+    void *d;
+    int r = HALSDK_API->value_by_name(1, name, &t, &d, &f);
+    if (r == 0) {
+        *type = (hal_type_t)t;
+        *data = (hal_data_u *)d;
+        if (has_writers)
+            *has_writers = f;
+    }
+    return r;
+}
+static inline int hal_get_param_value_by_name(const char *name,
+                                              hal_type_t *type,
+                                              hal_data_u **data)
+{
+    int t;
+    void *d;
+    int r = HALSDK_API->value_by_name(2, name, &t, &d, NULL);
+    if (r == 0) {
+        *type = (hal_type_t)t;
+        *data = (hal_data_u *)d;
+    }
+    return r;
+}
+
 /* aliases: an empty or NULL alias removes the alias */
 static inline int hal_pin_alias(const char *pin_name, const char *alias)
 {
@@ -274,6 +359,13 @@ static inline int hal_stop_threads(void)
 {
     return HALSDK_API->stop_threads();
 }
+
+/* a component that can make instances at run time: halcmd's
+   'newinst COMP NAME [k=v ...]' calls make(NAME, "k=v ...") in the
+   host.  Defined in the module's entry code (c_module.c). */
+typedef int (*constructor)(char *prefix, char *arg);
+typedef int (*hal_constructor_t)(const char *prefix, const char *arg);
+extern int hal_set_constructor(int comp_id, constructor make);
 
 /* halsdk additions: instances made at run time (newinst), and the
    message of the last failed call */

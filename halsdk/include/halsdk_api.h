@@ -21,7 +21,7 @@
 extern "C" {
 #endif
 
-#define HALSDK_API_VERSION 4
+#define HALSDK_API_VERSION 5
 #define HALSDK_CAPSULE_NAME "halsdk.core._core._C_API"
 
 /* longest object name, not counting the terminating NUL */
@@ -150,6 +150,16 @@ typedef struct halsdk_api {
     void *(*symbol_find)(const char *name, const char *user_module);
     void (*symbol_drop)(const char *module);
     const char *(*symbol_user)(const char *module);
+
+    /* --- version 5: the reference's lookups by id and by name --- */
+    /* the name of a component or instance (NULL: no such id) */
+    const char *(*comp_name)(int comp_id);
+    /* set a param from a value of its type (0 or -errno) */
+    int (*param_set)(const char *name, int type, const void *value);
+    /* the type and value of a pin (kind 0), signal (1) or param (2);
+       *flag: the pin is linked / the signal has a writer */
+    int (*value_by_name)(int kind, const char *name, int *type,
+                         void **data, int *flag);
 } halsdk_api;
 
 #ifdef __cplusplus

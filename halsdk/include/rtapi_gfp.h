@@ -1,8 +1,15 @@
-/* rtapi_gfp.h - allocation flags of rtapi_kmalloc (ignored in userspace) */
+/* rtapi_gfp.h - allocation flags of rtapi_kmalloc (ignored in userspace;
+   names and values as the reference's user-space build has them) */
 #ifndef RTAPI_GFP_H
 #define RTAPI_GFP_H
-typedef unsigned rtapi_gfp_t;
-#define RTAPI_GFP_KERNEL 0u
-#define RTAPI_GFP_ATOMIC 1u
-#define RTAPI_GFP_DMA 2u
+enum rtapi_gfp_e {
+    RTAPI_GFP_BUFFER,
+    RTAPI_GFP_ATOMIC,
+    RTAPI_GFP_KERNEL,
+    RTAPI_GFP_USER,
+    RTAPI_GFP_NOBUFFER,
+    RTAPI_GFP_NFS,
+    RTAPI_GFP_DMA
+};
+typedef unsigned long rtapi_gfp_t;
 #endif

@@ -13,4 +13,17 @@ typedef uint32_t rtapi_u32;
 typedef uint64_t rtapi_u64;
 typedef intptr_t rtapi_intptr_t;
 typedef uintptr_t rtapi_uintptr_t;
+
+#define RTAPI_INT8_MIN INT8_MIN
+#define RTAPI_INT8_MAX INT8_MAX
+#define RTAPI_UINT8_MAX UINT8_MAX
+#define RTAPI_INT16_MIN INT16_MIN
+#define RTAPI_INT16_MAX INT16_MAX
+#define RTAPI_UINT16_MAX UINT16_MAX
+#define RTAPI_INT32_MIN INT32_MIN
+#define RTAPI_INT32_MAX INT32_MAX
+#define RTAPI_UINT32_MAX UINT32_MAX
+#define RTAPI_INT64_MIN INT64_MIN
+#define RTAPI_INT64_MAX INT64_MAX
+#define RTAPI_UINT64_MAX UINT64_MAX
 #endif

@@ -13,6 +13,8 @@
 #include <Python.h>
 
 #include <errno.h>
+#include <limits.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -62,6 +64,79 @@ static int export_symbols(void)
             return r;
         }
     }
+    return 0;
+}
+
+/* ---------------------------------------------- rtapi_shmem_* (rtapi.h)
+   A block of key K is the instance's shared block "rtapi-shmem-K" (hex);
+   the module knows it by an id, its index in this table plus one. */
+#define MAX_SHMEM 64
+static long long shmem_handle[MAX_SHMEM];      /* handle + 1; 0: free */
+
+int rtapi_shmem_new(int key, int module_id, unsigned long int size)
+{
+    char name[32];
+    if (size == 0 || size > (unsigned long)LONG_MAX)
+        return -EINVAL;
+    snprintf(name, sizeof(name), "rtapi-shmem-%08x", (unsigned)key);
+    long long h = halsdk_api_ptr->shmem_attach(name);
+    if (h < 0) {
+        h = halsdk_api_ptr->shmem_new(name, module_id, (long)size);
+        if (h == -EEXIST)
+            h = halsdk_api_ptr->shmem_attach(name);
+    }
+    if (h < 0)
+        return (int)h;
+    if (halsdk_api_ptr->shmem_size(h) < (long)size) {
+        return -EINVAL;         /* made smaller by its first user */
+    }
+    for (int i = 0; i < MAX_SHMEM; i++) {
+        if (!shmem_handle[i]) {
+            shmem_handle[i] = h + 1;
+            return i + 1;
+        }
+    }
+    return -ENOMEM;
+}
+
+static long long shmem_of(int shmem_id)
+{
+    if (shmem_id < 1 || shmem_id > MAX_SHMEM || !shmem_handle[shmem_id - 1])
+        return -1;
+    return shmem_handle[shmem_id - 1] - 1;
+}
+
+int rtapi_shmem_delete(int shmem_id, int module_id)
+{
+    (void)module_id;
+    if (shmem_of(shmem_id) < 0)
+        return -EINVAL;
+    /* the block itself goes with the component that made it */
+    shmem_handle[shmem_id - 1] = 0;
+    return 0;
+}
+
+int rtapi_shmem_getptr(int shmem_id, void **ptr)
+{
+    long long h = shmem_of(shmem_id);
+    void *p = h < 0 ? NULL : halsdk_api_ptr->shmem_ptr(h);
+    if (!p)
+        return -EINVAL;
+    *ptr = p;
+    return 0;
+}
+
+/* ------------------------------------------ hal_set_constructor (hal.h) */
+typedef int (*constructor)(char *prefix, char *arg);
+static constructor make_instance;
+static int make_comp;
+
+int hal_set_constructor(int comp_id, constructor make)
+{
+    if (!halsdk_api_ptr->comp_name(comp_id))
+        return -EINVAL;
+    make_instance = make;
+    make_comp = comp_id;
     return 0;
 }
 
@@ -116,6 +191,11 @@ void halsdk_modparam_register(const char *name, char kind, void *addr,
 
 int rtapi_app_main(void);
 void rtapi_app_exit(void) __attribute__((weak));
+
+/* rtapi_app_exit() undoes a successful rtapi_app_main() only: as in the
+   reference, a module whose rtapi_app_main() failed is dropped without
+   it (its exit code may use state that was never made) */
+static int started;
 
 static PyObject *scalar_value(char kind, void *addr)
 {
@@ -333,15 +413,70 @@ static PyObject *mod_setup(PyObject *self, PyObject *args, PyObject *kw)
     if (r == 0)
         fputs(msgs, stderr);
 #endif
+    started = r == 0;
     if (r == 0)
         Py_RETURN_NONE;
     setup_failed(r, msgs, halsdk_api_ptr->last_error());
     return NULL;
 }
 
+/* newinst COMP NAME [arg=TEXT]: the constructor the module set with
+   hal_set_constructor() makes the instance NAME */
+static PyObject *mod_new_instance(PyObject *self, PyObject *args,
+                                  PyObject *kw)
+{
+    const char *name, *arg = "";
+    static char *kwlist[] = {"name", "arg", NULL};
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "s|s:new_instance", kwlist,
+                                     &name, &arg))
+        return NULL;
+    if (!make_instance) {
+        PyObject *errors = PyImport_ImportModule("halsdk.core.errors");
+        PyObject *cls = errors ? PyObject_GetAttrString(errors,
+                                                        "NotPermittedError")
+                               : NULL;
+        Py_XDECREF(errors);
+        if (cls) {
+            PyErr_Format(cls, "component '%s' does not support instances "
+                         "(newinst): it set no constructor",
+                         STR_(HALSDK_MODULE_NAME));
+            Py_DECREF(cls);
+        }
+        return NULL;
+    }
+    char *prefix = strdup(name), *text = strdup(arg);
+    if (!prefix || !text) {
+        free(prefix);
+        free(text);
+        return PyErr_NoMemory();
+    }
+    int r;
+    Py_BEGIN_ALLOW_THREADS
+    halsdk_api_ptr->msg_capture(1);
+    /* the new pins belong to the component, which takes them while it
+       is not ready */
+    r = halsdk_api_ptr->comp_unready(make_comp);
+    if (r == 0) {
+        r = make_instance(prefix, text);
+        halsdk_api_ptr->comp_ready(make_comp);
+    }
+    halsdk_api_ptr->msg_capture(0);
+    Py_END_ALLOW_THREADS
+    free(prefix);
+    free(text);
+    const char *msgs = halsdk_api_ptr->captured_msgs();
+    if (r == 0) {
+        fputs(msgs, stderr);
+        Py_RETURN_NONE;
+    }
+    setup_failed(r, msgs, halsdk_api_ptr->last_error());
+    return NULL;
+}
+
 static PyObject *mod_cleanup(PyObject *self, PyObject *unused)
 {
-    if (rtapi_app_exit) {
+    if (rtapi_app_exit && started) {
+        started = 0;
         Py_BEGIN_ALLOW_THREADS
         rtapi_app_exit();
         Py_END_ALLOW_THREADS
@@ -355,6 +490,9 @@ static PyMethodDef methods[] = {
      METH_VARARGS | METH_KEYWORDS,
      "Set module parameters and run rtapi_app_main()."},
     {"cleanup", mod_cleanup, METH_NOARGS, "Run rtapi_app_exit()."},
+    {"new_instance", (PyCFunction)(void (*)(void))mod_new_instance,
+     METH_VARARGS | METH_KEYWORDS,
+     "Make an instance with the hal_set_constructor() function."},
     {NULL, NULL, 0, NULL}
 };
 
@@ -399,6 +537,14 @@ PyMODINIT_FUNC CAT_(PyInit_, HALSDK_MODULE_NAME)(void)
     }
     if (!mp || PyModule_AddObject(m, "modparams", mp) < 0) {
         Py_XDECREF(mp);
+        Py_DECREF(m);
+        return NULL;
+    }
+    /* newinst's one parameter: the constructor's argument */
+    PyObject *ip = Py_BuildValue("{s:(C s s)}", "arg", 's', "",
+                                 "the argument of the constructor");
+    if (!ip || PyModule_AddObject(m, "instance_params", ip) < 0) {
+        Py_XDECREF(ip);
         Py_DECREF(m);
         return NULL;
     }

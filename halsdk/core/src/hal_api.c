@@ -6,6 +6,7 @@
 
 #include <errno.h>
 #include <stdio.h>
+#include <string.h>
 
 /* set by the loader while a module's setup runs: its hal_init()s are
    realtime components */
@@ -131,6 +132,97 @@ static int api_get_msg_level(void)
     return hal_map.hdr ? hal_map.hdr->msg_level : 1;
 }
 
+/* the name of a component or instance of this instance, or NULL */
+static const char *api_comp_name(int id)
+{
+    if (!hal_map.hdr || hal_lock())
+        return NULL;
+    hal_comp_t *c = hal_comp_by_id(id);
+    hal_inst_t *i = c ? NULL : hal_inst_by_id(id);
+    const char *name = c ? c->o.name : i ? i->o.name : NULL;
+    hal_unlock();
+    return name;
+}
+
+static long type_bytes(int type)
+{
+    switch (type) {
+    case HALSDK_BIT: return 1;
+    case HALSDK_S32: case HALSDK_U32: return 4;
+    case HALSDK_FLOAT: case HALSDK_S64: case HALSDK_U64: return 8;
+    default: return 0;
+    }
+}
+
+/* set a param by name from a value of its type, as setp does */
+static int api_param_set(const char *name, int type, const void *value)
+{
+    if (!name || !value)
+        return hal_fail(EINVAL, "hal_param_set: no name or no value");
+    if (!hal_map.hdr)
+        return hal_fail(ENODEV, "no HAL instance is attached");
+    int r = hal_lock();
+    if (r)
+        return r;
+    hal_param_t *p = hal_find(K_PARAM, name);
+    if (!p)
+        r = hal_fail(ENOENT, "param '%s' not found", name);
+    else if (p->type != type)
+        r = hal_fail(EINVAL, "param '%s': type %d does not match its "
+                     "type %d", name, type, p->type);
+    else if (!(r = hal_check_settable(&p->o, 0))) {
+        void *data = hal_param_value(p);
+        if (type == HALSDK_BIT)
+            *(volatile uint8_t *)data = *(const uint8_t *)value != 0;
+        else
+            memcpy(data, value, (size_t)type_bytes(type));
+    }
+    hal_unlock();
+    return r;
+}
+
+/* where the value of a pin (kind 0), signal (1) or param (2) is; flag:
+   a pin is linked / a signal has a writer */
+static int api_value_by_name(int kind, const char *name, int *type,
+                             void **data, int *flag)
+{
+    static const int kinds[] = {K_PIN, K_SIG, K_PARAM};
+    if (!name || kind < 0 || kind > 2)
+        return hal_fail(EINVAL, "hal_get_value_by_name: bad arguments");
+    if (!hal_map.hdr)
+        return hal_fail(ENODEV, "no HAL instance is attached");
+    int r = hal_lock();
+    if (r)
+        return r;
+    void *o = hal_find(kinds[kind], name);
+    int f = 0;
+    if (!o) {
+        hal_unlock();
+        return hal_fail(ENOENT, "%s '%s' not found",
+                        kind == 0 ? "pin" : kind == 1 ? "signal" : "param",
+                        name);
+    }
+    if (kind == 0) {
+        hal_pin_t *p = o;
+        *type = p->type;
+        *data = (void *)hal_pin_value(p);
+        f = p->signal != 0;
+    } else if (kind == 1) {
+        hal_sig_t *s = o;
+        *type = s->type;
+        *data = (void *)&s->value;
+        f = s->writers > 0;
+    } else {
+        hal_param_t *p = o;
+        *type = p->type;
+        *data = hal_param_value(p);
+    }
+    if (flag)
+        *flag = f;
+    hal_unlock();
+    return 0;
+}
+
 const halsdk_api halsdk_api_table = {
     .version = HALSDK_API_VERSION,
     .size = sizeof(halsdk_api),
@@ -183,4 +275,7 @@ const halsdk_api halsdk_api_table = {
     .symbol_find = hal_symbol_find,
     .symbol_drop = hal_symbol_drop,
     .symbol_user = hal_symbol_user,
+    .comp_name = api_comp_name,
+    .param_set = api_param_set,
+    .value_by_name = api_value_by_name,
 };

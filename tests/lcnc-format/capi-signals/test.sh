@@ -1,0 +1,5 @@
+# build the hand-written module with halcompile, load it from a HAL file
+export HALSDK_PATH=$PWD
+halcompile --compile capisig.c > /dev/null 2>&1 || echo "halcompile failed"
+halrun -f signals.hal
+echo "halrun: $?"
