@@ -48,16 +48,23 @@ def test_ring_wraps_around_and_numbers_samples(hal):
 
 
 def test_overrun_and_underrun_counts(hal):
-    s = _core.stream_create("oru", _owner(), 2, "u")
+    # depth 3 holds 2 records, as the reference's streams
+    s = _core.stream_create("oru", _owner(), 3, "u")
     assert s.read() is None
     assert s.underruns == 1
+    assert s.room == 2
     assert [s.write([v]) for v in (1, 2, 3, 4)] == [True, True, False, False]
-    assert (s.overruns, s.depth, s.sampleno) == (2, 2, 2)
+    assert (s.overruns, s.depth, s.sampleno, s.room) == (2, 2, 2, 0)
     # a dropped record takes no sample number; the oldest records stay
     assert s.read() == (0, (1,))
     assert s.write([5]) is True
     assert [s.read(), s.read(), s.read()] == [(1, (2,)), (2, (5,)), None]
-    assert (s.overruns, s.underruns) == (2, 2)
+    assert (s.overruns, s.underruns, s.room) == (2, 2, 2)
+
+
+def test_depth_one_holds_nothing(hal):
+    s = _core.stream_create("none", _owner(), 1, "f")
+    assert (s.maxdepth, s.room, s.write([1.0]), s.overruns) == (1, 0, False, 1)
 
 
 def test_all_types_with_64_bit_extremes(hal):
@@ -84,7 +91,7 @@ def test_all_types_with_64_bit_extremes(hal):
 
 def test_more_than_21_values_up_to_256(hal):
     owner = _owner()
-    s = _core.stream_create("wide", owner, 5, "l" * 256)
+    s = _core.stream_create("wide", owner, 6, "l" * 256)
     for k in range(5):
         assert s.write([k * 1000 + i for i in range(256)])
     arr = s.read_many(names=[f"c{i}" for i in range(256)])
@@ -211,12 +218,12 @@ def test_sampler_pins_and_functions(hal):
 
 
 def test_sampler_records_each_cycle_exactly(hal):
-    _counting_sampler(hal, depth=4)
+    _counting_sampler(hal, depth=5)   # holds 4 records
     hal.step(3)
     assert hal.getp("sampler.0.curr-depth") == 3
     assert hal.getp("sampler.0.full") is False
     hal.step(3)                       # 6 cycles into 4 slots
-    assert hal.getp("sampler.0.curr-depth") == 4
+    assert hal.getp("sampler.0.curr-depth") == 5      # the depth
     assert hal.getp("sampler.0.full") is True
     assert hal.getp("sampler.0.overruns") == 2
     # as in the reference, sample-num is not advanced by sampler (the
@@ -241,7 +248,7 @@ def test_sampler_records_each_cycle_exactly(hal):
 
 
 def test_sampler_overruns_pin_can_be_reset(hal):
-    _counting_sampler(hal, depth=1)
+    _counting_sampler(hal, depth=2)   # holds 1 record
     hal.step(4)
     assert hal.getp("sampler.0.overruns") == 3
     hal.setp("sampler.0.overruns", 0)
