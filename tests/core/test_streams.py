@@ -243,7 +243,8 @@ def test_sampler_records_each_cycle_exactly(hal):
     assert s.read() == (4, (7 / 4, True, -7, 21, -(7 << 40)))
     hal.setp("sampler.0.enable", False)
     hal.step(5)
-    assert s.depth == 0 and hal.getp("sampler.0.curr-depth") == 1
+    # as the reference: while disabled, curr-depth follows the reader
+    assert s.depth == 0 and hal.getp("sampler.0.curr-depth") == 0
     assert hal.getp("sampler.0.overruns") == 2
 
 
@@ -510,15 +511,20 @@ def test_streamer_plays_one_record_per_cycle(hal):
     hal.step(2)
     assert hal.getp("streamer.0.pin.2") == -3
     assert hal.getp("streamer.0.underruns") == 0
-    hal.step(2)                       # empty: the pins keep their values
+    hal.step(2)                       # empty: the pins keep their values,
+    # the underruns count on the pin only (as the reference's streamer)
     assert hal.getp("streamer.0.pin.2") == -3
     assert hal.getp("streamer.0.empty") is True
     assert hal.getp("streamer.0.underruns") == 2
     assert hal.getp("streamer.0.curr-depth") == 0
+    assert s.underruns == 0
     hal.setp("streamer.0.enable", False)
     s.write([9.0, 0, 9, 9])
     hal.step(3)
     assert s.depth == 1 and hal.getp("streamer.0.pin.2") == -3
+    # curr-depth and empty follow the FIFO while disabled
+    assert hal.getp("streamer.0.curr-depth") == 1
+    assert hal.getp("streamer.0.empty") is False
     assert hal.getp("streamer.0.underruns") == 2
     hal.setp("streamer.0.enable", True)
     hal.step(1)
@@ -592,8 +598,10 @@ def test_halstreamer_waits_while_the_fifo_is_full(hal, tmp_path):
             if hal.getp("streamer.0.curr-depth") == 0 and \
                     hal.stream("streamer.0").depth == 0:
                 time.sleep(0.01)
+            underruns = hal.getp("streamer.0.underruns")
             hal.step(1)
-            if not hal.getp("streamer.0.empty"):
+            # a cycle plays a record or counts an underrun
+            if hal.getp("streamer.0.underruns") == underruns:
                 seen.append(hal.getp("streamer.0.pin.0"))
         assert proc.wait(timeout=20) == 0
     finally:
