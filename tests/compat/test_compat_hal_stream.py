@@ -28,6 +28,7 @@ from pathlib import Path
 
 import pytest
 from helpers import data_path, repo_path
+from helpers.docblocks import fenced_blocks
 from helpers.halrun import tools_env
 
 import halsdk
@@ -107,6 +108,29 @@ def test_lcnc_format(folder: Path, tmp_path: Path):
                                 "result"], cwd=work, capture_output=True,
                                text=True, timeout=60)
         assert check.returncode == 0, check.stdout + proc.stderr
+    assert _shm_left(env) == []
+
+
+def test_compat_page_example_feeds_a_streamer(tmp_path: Path):
+    """The Python example of docs/compat.md, started as the page says."""
+    (block,) = fenced_blocks(repo_path("docs", "compat.md"), "python")
+    work = tmp_path / "work"
+    work.mkdir()
+    (work / "feed.py").write_text(block)
+    (work / "feed.hal").write_text(
+        "loadrt threads name1=servo period1=1000000\n"
+        "loadrt streamer depth=8 cfg=ff\n"
+        "addf streamer.0 servo\n"
+        "start\n"
+        "loadusr -w python3 feed.py\n"
+        "loadusr -w sleep 0.1\n"
+        "stop\n"
+        "getp streamer.0.pin.0\n"
+        "getp streamer.0.curr-depth\n")
+    env = _env("doc", tmp_path)
+    proc = _halrun("feed.hal", work, env)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout == "fed 20 records, overruns: 0\n9.5\n0\n"
     assert _shm_left(env) == []
 
 
