@@ -35,6 +35,9 @@ cdef void sample(void *arg, long period) noexcept nogil:
     cdef void *p
     cdef int t
     if not c.enable[0]:
+        # as the reference: curr-depth follows the reader while disabled
+        t = hal.halsdk_stream_depth(c.stream)
+        c.curr_depth[0] = t if t > 0 else 0
         return
     for i in range(c.n):
         p = c.pins[i]

@@ -34,8 +34,14 @@ cdef struct channel_t:
 
 cdef void play(void *arg, long period) noexcept nogil:
     cdef channel_t *c = <channel_t *>arg
-    cdef int i, t, clk, tick, mode
+    cdef int i, t, clk, tick, mode, depth
     cdef void *p
+    # as the reference: curr-depth and empty follow the FIFO every cycle,
+    # enabled or not, and an empty FIFO at a tick counts on the underruns
+    # pin only (the stream's own underrun count is its reader's)
+    depth = hal.halsdk_stream_depth(c.stream)
+    c.curr_depth[0] = depth if depth > 0 else 0
+    c.empty[0] = depth <= 0
     if not c.enable[0]:
         return
     clk = 1 if c.clock[0] else 0
@@ -51,13 +57,12 @@ cdef void play(void *arg, long period) noexcept nogil:
     c.last_clock = clk
     if not tick:
         return
-    if hal.halsdk_stream_read(c.stream, c.rec, NULL) < 0:
-        c.empty[0] = 1
+    if depth <= 0 or hal.halsdk_stream_read(c.stream, c.rec, NULL) < 0:
         c.underruns[0] += 1
-        c.curr_depth[0] = 0
         return
-    c.empty[0] = 0
-    c.curr_depth[0] = hal.halsdk_stream_depth(c.stream)
+    depth = hal.halsdk_stream_depth(c.stream)
+    c.curr_depth[0] = depth if depth > 0 else 0
+    c.empty[0] = depth <= 0
     for i in range(c.n):
         p = c.pins[i]
         t = c.types[i]

@@ -613,6 +613,16 @@ class Hal:
         can be read in bulk into NumPy arrays (``read_many``)."""
         return _core.stream_attach(name)
 
+    def new_stream(self, name: str, depth: int, typestring: str,
+                   owner: Component) -> _core.Stream:
+        """Create the stream ``name`` of ``depth`` (it holds ``depth - 1``
+        records, as the reference's streams) with one value per letter of
+        ``typestring`` (f float, b bit, s s32, u u32, l s64, k u64), owned
+        by ``owner``, a component of this process (the stream is deleted
+        with it).  ConflictError when the name is taken, InvalidError for
+        a bad depth or type string."""
+        return _core.stream_create(name, owner.id, depth, typestring)
+
     def capture(self, names: Union[str, Iterable[str]], cycles: int,
                 thread: Optional[str] = None, position: int = -1,
                 timeout: Optional[float] = None) -> dict:

@@ -25,14 +25,17 @@ LinuxCNC.  Errors raise the same exception types as LinuxCNC's module;
 
 from __future__ import annotations
 
+import ctypes
+import errno
 import operator
+import os
 import signal as _signal
 import sys
 import threading
 from typing import Any, Optional, Union
 
 import halsdk
-from halsdk.errors import HalError, Rule, StaleError
+from halsdk.errors import ExistsError, HalError, NotFoundError, Rule, StaleError
 from halsdk.types import INT_RANGES, Direction, HalType
 
 __all__ = [
@@ -41,6 +44,7 @@ __all__ = [
     "MSG_NONE", "MSG_ERR", "MSG_WARN", "MSG_INFO", "MSG_DBG", "MSG_ALL",
     "is_kernelspace", "is_rt", "is_sim", "is_userspace", "kernel_version",
     "error", "item", "Pin", "Param", "component", "stream", "shm",
+    "streamer_base", "sampler_base",
     "component_exists", "component_is_ready", "connect", "disconnect",
     "new_sig", "set_p", "get_value", "pin_has_writer", "get_info_pins",
     "get_info_params", "get_info_signals", "get_msg_level", "set_msg_level",
@@ -495,20 +499,339 @@ class component:  # noqa: N801 - the reference's name
                 f"{len(self._c_items)} pins and params>")
 
 
+# ---------------------------------------------------------------- streams
+
+#: key of the stream of ``loadrt streamer`` channel 0 (channel N: + N)
+streamer_base = 0x48535430
+#: key of the stream of ``loadrt sampler`` channel 0 (channel N: + N)
+sampler_base = 0x48534130
+# channels of streamer/sampler reached by key (base + N, N below this)
+_CHANNELS = 256
+
+
+def _stream_name(key: int) -> str:
+    """The name of the stream of a key: ``streamer.N`` and ``sampler.N``
+    for the keys of the reference's streamer and sampler channels (so
+    halstreamer, halsampler and the components find them), else
+    ``stream.KKKKKKKK`` (the key in hex)."""
+    k = key & 0xFFFFFFFF
+    for base, comp in ((streamer_base, "streamer"), (sampler_base, "sampler")):
+        if 0 <= k - base < _CHANNELS:
+            return f"{comp}.{k - base}"
+    return f"stream.{k:08x}"
+
+
+def _shm_name(key: int) -> str:
+    """The name of the shared block of a key: ``shm.KKKKKKKK``."""
+    return f"shm.{key & 0xFFFFFFFF:08x}"
+
+
+def _int32(value: Any) -> int:
+    """An int argument as the reference parses a C ``int``."""
+    number = operator.index(value)
+    if number > 0x7FFFFFFF:
+        raise OverflowError("signed integer is greater than maximum")
+    if number < -0x80000000:
+        raise OverflowError("signed integer is less than minimum")
+    return number
+
+
+def _os_error(code: int) -> OSError:
+    return OSError(code, os.strerror(code))
+
+
+def _tname(value: Any) -> str:
+    """The type of a value as the reference's argument errors name it."""
+    return "None" if value is None else type(value).__name__
+
+
+def _need_component(value: Any, who: str) -> component:
+    if not isinstance(value, component):
+        raise TypeError(f"{who}argument 1 must be hal.component, not "
+                        f"{_tname(value)}")
+    return value
+
+
+_LETTERS = {"f": HAL_FLOAT, "b": HAL_BIT, "s": HAL_S32, "u": HAL_U32,
+            "l": HAL_S64, "k": HAL_U64}
+
+
 class stream:  # noqa: N801 - the reference's name
-    """Not provided: LinuxCNC's ``hal.stream`` (sampler/streamer FIFOs)."""
+    """A FIFO of records shared with a realtime component or another
+    process, found by a key (an int).
+
+    ``stream(comp, key, depth, cfg)`` creates it (the creator) with one
+    value per letter of ``cfg`` (f float, b bit, s s32, u u32, and l s64,
+    k u64); a stream of ``depth`` holds ``depth - 1`` records.
+    ``stream(comp, key[, cfg])`` attaches to an existing one (``cfg``, if
+    given, must match its types).  ``streamer_base + N`` is the stream of
+    ``loadrt streamer`` channel N (write it), ``sampler_base + N`` that of
+    ``loadrt sampler`` channel N (read it).  One process writes, one reads.
+    """
+
+    __slots__ = ("_s", "_key", "_creator", "_sampleno", "_types")
+    _s: Any
+    _key: int
+    _creator: bool
+    _sampleno: int
+    _types: list
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
-        raise NotImplementedError("hal.stream is not provided by "
-                                  "halsdk.compat.hal")
+        for kw in kwargs:
+            if kw not in ("depth", "cfg"):
+                raise TypeError(f"hal.stream() got an unexpected keyword "
+                                f"argument '{kw}'")
+        if len(args) < 2:
+            raise TypeError(f"hal.stream() takes at least 2 arguments "
+                            f"({len(args)} given)")
+        if len(args) > 4:
+            raise TypeError(f"hal.stream() takes at most 4 arguments "
+                            f"({len(args)} given)")
+        comp, key, *rest = args
+        depth: Any = rest[0] if len(rest) == 2 else None
+        cfg: Any = rest[-1] if rest else None
+        for kw, given in (("depth", len(rest) == 2), ("cfg", bool(rest))):
+            if kw in kwargs:
+                if given:
+                    raise TypeError(f"argument for hal.stream() given by "
+                                    f"name ('{kw}') and position")
+                if kw == "depth":
+                    depth = kwargs[kw]
+                else:
+                    cfg = kwargs[kw]
+        _need_component(comp, "hal.stream() ")
+        key = _int32(key)
+        creating = depth is not None
+        if creating:
+            depth = _int32(depth)
+        if cfg is not None and not isinstance(cfg, str):
+            raise TypeError(f"hal.stream() argument {4 if creating else 3} "
+                            f"must be str, not {_tname(cfg)}")
+        name = _stream_name(key)
+        if creating:
+            if cfg is None:
+                raise TypeError("hal.stream() needs cfg to create a stream")
+            found = self._create(comp, name, depth, cfg)
+        else:
+            found = self._attach(name, cfg)
+        setattr_ = object.__setattr__
+        setattr_(self, "_s", found)
+        setattr_(self, "_key", key & 0xFFFFFFFF)
+        setattr_(self, "_creator", creating)
+        setattr_(self, "_sampleno", 0)
+        setattr_(self, "_types", list(found.types))
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        if isinstance(getattr(type(self), name, None), property):
+            raise AttributeError("readonly attribute")
+        raise AttributeError(f"'hal.stream' object has no attribute "
+                             f"'{name}'")
+
+    @staticmethod
+    def _create(comp: component, name: str, depth: int, cfg: str) -> Any:
+        comp._check_live()
+        if depth < 1:
+            raise _os_error(errno.EINVAL)
+        try:
+            return _need_instance().new_stream(name, depth, cfg,
+                                               comp._c_comp)
+        except ExistsError:
+            print(f"stream: ERROR: a stream with key {name} exists",
+                  file=sys.stderr)
+            raise _os_error(errno.EEXIST) from None
+        except HalError as exc:
+            print(f"stream: ERROR: {exc}", file=sys.stderr)
+            raise _os_error(errno.EINVAL) from None
+
+    @staticmethod
+    def _attach(name: str, cfg: Optional[str]) -> Any:
+        hal = halsdk.Hal.current()
+        if hal is None:
+            raise RuntimeError(_NO_COMPONENT)
+        try:
+            found = hal.stream(name)
+        except NotFoundError:
+            raise _os_error(errno.EINVAL) from None
+        if cfg is None:
+            return found
+        types = found.types
+        if not cfg:
+            print("stream: ERROR: empty cfg", file=sys.stderr)
+            raise _os_error(errno.EINVAL)
+        # as the reference: the letters given must match the first types
+        for i, letter in enumerate(cfg):
+            want = _LETTERS.get(letter.lower())
+            if want is None:
+                print(f"stream: ERROR: unknown type '{letter}', must be F, "
+                      "B, S, U, L or K", file=sys.stderr)
+                raise _os_error(errno.EINVAL)
+            if i >= len(types) or types[i] != want:
+                have = (_TYPE_NAMES[types[i]].lower() if i < len(types)
+                        else "nothing")
+                print(f"stream: ERROR: type mismatch: value {i} is {have}, "
+                      f"cfg says {_TYPE_NAMES[want].lower()}",
+                      file=sys.stderr)
+                raise _os_error(errno.EINVAL)
+        return found
+
+    def _live(self) -> Any:
+        """The core stream, or RuntimeError when its owner is gone."""
+        if halsdk.Hal.current() is None or not self._s.exists:
+            raise RuntimeError("the stream no longer exists (its "
+                               "component was removed)")
+        return self._s
+
+    def write(self, *args: Any, **kwargs: Any) -> None:
+        """Append one record, a tuple of one value per type (converted as
+        pin values are); OSError ENOSPC (and one more overrun) when
+        full."""
+        if kwargs:
+            raise TypeError("stream.write() takes no keyword arguments")
+        if len(args) != 1:
+            raise TypeError(f"hal.stream.write() takes exactly 1 argument "
+                            f"({len(args)} given)")
+        values = args[0]
+        if not isinstance(values, tuple):
+            raise TypeError(f"hal.stream.write() argument 1 must be tuple, "
+                            f"not {_tname(values)}")
+        types = self._types
+        if len(values) < len(types):
+            raise ValueError("Too few elements to unpack")
+        if len(values) > len(types):
+            raise ValueError("Too many elements to unpack")
+        record = [_convert(t, v) for t, v in zip(types, values)]
+        if not self._live().write(record):
+            raise _os_error(errno.ENOSPC)
+
+    def read(self, *args: Any, **kwargs: Any) -> Optional[tuple]:
+        """The oldest record as a tuple, or None (and one more underrun)
+        when the stream is empty."""
+        if kwargs:
+            raise TypeError("stream.read() takes no keyword arguments")
+        if args:
+            raise TypeError(f"stream.read() takes no arguments "
+                            f"({len(args)} given)")
+        got = self._live().read()
+        if got is None:
+            return None
+        sampleno, values = got
+        object.__setattr__(self, "_sampleno", sampleno + 1)
+        return values
+
+    @property
+    def depth(self) -> int:
+        """Records waiting to be read."""
+        return self._live().depth
+
+    @property
+    def maxdepth(self) -> int:
+        """The depth the stream was created with."""
+        return self._live().maxdepth
+
+    @property
+    def element_types(self) -> bytes:
+        """The cfg letters of the values, lowercase (``b'fbsu'``)."""
+        return self._live().typestring.encode()
+
+    @property
+    def num_overruns(self) -> int:
+        """Writes that found the stream full."""
+        return self._live().overruns
+
+    @property
+    def num_underruns(self) -> int:
+        """Reads that found the stream empty."""
+        return self._live().underruns
+
+    @property
+    def readable(self) -> bool:
+        """True if a record is waiting."""
+        return self._live().depth > 0
+
+    @property
+    def writable(self) -> bool:
+        """True if a record can be written."""
+        return self._live().room > 0
+
+    @property
+    def sampleno(self) -> int:
+        """The number of the last record this object read (records are
+        numbered from 1 by the writer; 0 before the first read)."""
+        return self._sampleno
+
+    def __repr__(self) -> str:
+        return (f"<stream 0x{self._key:x}"
+                f"{' creator' if self._creator else ''}>")
 
 
 class shm:  # noqa: N801 - the reference's name
-    """Not provided: LinuxCNC's ``hal.shm`` (raw shared-memory blocks)."""
+    """A block of shared memory found by a key (an int).
+
+    ``shm(comp, key, size)`` attaches to the block of that key, or creates
+    it (``size`` zeroed bytes, owned by ``comp``).  :meth:`getbuffer`
+    gives a writable memoryview of it (``struct.pack_into``,
+    ``numpy.frombuffer``, ``view.cast("I")``, ...).
+    """
+
+    __slots__ = ("_key", "_addr", "_block", "_size", "_comp", "_id")
+    _ids = 0
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
-        raise NotImplementedError("hal.shm is not provided by "
-                                  "halsdk.compat.hal")
+        if kwargs or len(args) != 3:
+            raise TypeError(f"function takes exactly 3 arguments "
+                            f"({len(args)} given)")
+        comp = _need_component(args[0], "")
+        key = _int32(args[1])
+        size = operator.index(args[2])
+        hal = halsdk.Hal.current()
+        if hal is None:
+            raise RuntimeError(_NO_COMPONENT)
+        name = _shm_name(key)
+        try:
+            addr, block = hal.shared_block(name)
+        except NotFoundError:
+            comp._check_live()
+            if size < 1:
+                raise error("Invalid argument") from None
+            try:
+                addr, block = hal.new_shared_block(name, size, comp._c_comp)
+            except HalError as exc:
+                print(f"shm: ERROR: {exc}", file=sys.stderr)
+                raise error("Invalid argument") from None
+        if not 0 < size <= block:
+            raise error("Invalid argument")
+        shm._ids += 1
+        self._id = shm._ids
+        self._key = key & 0xFFFFFFFF
+        self._addr = addr
+        self._block = block
+        self._size = size
+        self._comp = comp           # the block lives with its component
+
+    def getbuffer(self) -> memoryview:
+        """A writable memoryview of ``size`` bytes (format ``B``) of the
+        block; it keeps this object (and so its component) alive."""
+        raw = (ctypes.c_ubyte * self._size).from_address(self._addr)
+        raw._shm = self             # type: ignore[attr-defined]
+        return memoryview(raw).cast("B")
+
+    def setsize(self, *args: Any) -> None:
+        """Set the size of the views :meth:`getbuffer` gives (0 to the
+        size of the block)."""
+        if len(args) != 1:
+            raise TypeError(f"function takes exactly 1 argument "
+                            f"({len(args)} given)")
+        size = args[0]
+        if not isinstance(size, int):
+            raise TypeError(f"argument 1 must be int, not {_tname(size)}")
+        if not 0 <= size <= self._block:
+            raise ValueError(f"size {size} is outside the block (0 to "
+                             f"{self._block} bytes)")
+        self._size = size
+
+    def __repr__(self) -> str:
+        return (f"<shared memory buffer key={self._key:08x} id={self._id} "
+                f"size={self._size}>")
 
 
 # ---------------------------------------------------------------- functions

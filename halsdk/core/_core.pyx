@@ -227,6 +227,7 @@ cdef extern from "hal_core.h" nogil:
     int hal_stream_read(long long handle, halsdk_value_t *rec,
                         uint64_t *sampleno)
     int hal_stream_depth(long long handle)
+    int hal_stream_room(long long handle)
     int hal_stream_parse_types(const char *typestring, uint8_t *types,
                                const char *what)
     long long hal_get_time()
@@ -820,7 +821,8 @@ cdef class Stream(Item):
     One process writes (normally a realtime function), one reads.  Each
     record holds one value per letter of the type string (f float, b bit,
     s s32, u u32, l s64, k u64) and the number of the sample (records
-    written before it).  ``write``/``read`` never block.
+    written before it).  A stream of ``maxdepth`` D holds D - 1 records,
+    as the reference's do.  ``write``/``read`` never block.
     """
 
     cdef long long handle(self) except -1:
@@ -851,8 +853,13 @@ cdef class Stream(Item):
 
     @property
     def maxdepth(self) -> int:
-        """Capacity in records."""
+        """The depth it was made with (it holds one record less)."""
         return (<hal_stream_t *>self.rec()).depth
+
+    @property
+    def room(self) -> int:
+        """Records that can be written before it is full."""
+        return check(hal_stream_room(self.handle()))
 
     @property
     def depth(self) -> int:
@@ -1586,10 +1593,11 @@ def capture_new(int comp_id, funct_name, stream_name, items, long depth,
         if not isinstance(obj, (Pin, Param, Signal)):
             raise _errors.InvalidError(f"cannot capture {obj!r}")
         letters.append(_STREAM_LETTER[obj.type])
-    if depth < 1 or depth > 0x7fffffff:
+    if depth < 1 or depth >= 0x7fffffff:
         raise _errors.InvalidError(f"capture of {depth} cycles: 1 to "
-                                   f"{0x7fffffff} allowed")
-    st = stream_create(stream_name, comp_id, depth, "".join(letters))
+                                   f"{0x7fffffff - 1} allowed")
+    # room for depth records (a stream holds one less than its depth)
+    st = stream_create(stream_name, comp_id, depth + 1, "".join(letters))
     cdef capture_t *c = <capture_t *>hal_malloc_owned(sizeof(capture_t),
                                                       comp_id)
     if c == NULL:

@@ -380,7 +380,8 @@ static inline const char *halsdk_last_error(void)
 
 /* streams (halsdk): realtime-safe single-producer single-consumer FIFOs
    of records, one value (halsdk_value_t) per letter of the type string
-   (f float, b bit, s s32, u u32, l s64, k u64).  A handle is >= 0. */
+   (f float, b bit, s s32, u u32, l s64, k u64).  A stream of depth D
+   holds D - 1 records, as the reference's.  A handle is >= 0. */
 typedef long long halsdk_stream_t;
 static inline halsdk_stream_t halsdk_stream_create(const char *name,
                                                    int owner_id, int depth,

@@ -116,7 +116,6 @@ def feed(stream, lines: Iterable[str], stop: list,
     """Write the records of ``lines`` to ``stream``, waiting while it is
     full; False if ``stop`` became non-empty first."""
     types = stream.types
-    room = stream.maxdepth
     for lineno, line in enumerate(lines):
         if line.startswith("#"):
             continue
@@ -127,7 +126,7 @@ def feed(stream, lines: Iterable[str], stop: list,
                       "skipping the line\n")
             err.flush()
             continue
-        while stream.depth >= room:
+        while stream.room <= 0:
             if stop:
                 return False
             time.sleep(POLL_S)

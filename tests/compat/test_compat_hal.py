@@ -707,13 +707,6 @@ def test_msg_level(hal, comp):
     m.set_msg_level(m.MSG_ERR)
 
 
-def test_unsupported_classes_say_so():
-    with pytest.raises(NotImplementedError, match="hal.stream"):
-        compat.stream(0, 0)
-    with pytest.raises(NotImplementedError, match="hal.shm"):
-        compat.shm(0, 0)
-
-
 def test_sigterm_raises_keyboard_interrupt_unless_handled(hal,
                                                           sigterm_guard):
     m = compat

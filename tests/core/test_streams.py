@@ -48,16 +48,23 @@ def test_ring_wraps_around_and_numbers_samples(hal):
 
 
 def test_overrun_and_underrun_counts(hal):
-    s = _core.stream_create("oru", _owner(), 2, "u")
+    # depth 3 holds 2 records, as the reference's streams
+    s = _core.stream_create("oru", _owner(), 3, "u")
     assert s.read() is None
     assert s.underruns == 1
+    assert s.room == 2
     assert [s.write([v]) for v in (1, 2, 3, 4)] == [True, True, False, False]
-    assert (s.overruns, s.depth, s.sampleno) == (2, 2, 2)
+    assert (s.overruns, s.depth, s.sampleno, s.room) == (2, 2, 2, 0)
     # a dropped record takes no sample number; the oldest records stay
     assert s.read() == (0, (1,))
     assert s.write([5]) is True
     assert [s.read(), s.read(), s.read()] == [(1, (2,)), (2, (5,)), None]
-    assert (s.overruns, s.underruns) == (2, 2)
+    assert (s.overruns, s.underruns, s.room) == (2, 2, 2)
+
+
+def test_depth_one_holds_nothing(hal):
+    s = _core.stream_create("none", _owner(), 1, "f")
+    assert (s.maxdepth, s.room, s.write([1.0]), s.overruns) == (1, 0, False, 1)
 
 
 def test_all_types_with_64_bit_extremes(hal):
@@ -84,7 +91,7 @@ def test_all_types_with_64_bit_extremes(hal):
 
 def test_more_than_21_values_up_to_256(hal):
     owner = _owner()
-    s = _core.stream_create("wide", owner, 5, "l" * 256)
+    s = _core.stream_create("wide", owner, 6, "l" * 256)
     for k in range(5):
         assert s.write([k * 1000 + i for i in range(256)])
     arr = s.read_many(names=[f"c{i}" for i in range(256)])
@@ -211,12 +218,12 @@ def test_sampler_pins_and_functions(hal):
 
 
 def test_sampler_records_each_cycle_exactly(hal):
-    _counting_sampler(hal, depth=4)
+    _counting_sampler(hal, depth=5)   # holds 4 records
     hal.step(3)
     assert hal.getp("sampler.0.curr-depth") == 3
     assert hal.getp("sampler.0.full") is False
     hal.step(3)                       # 6 cycles into 4 slots
-    assert hal.getp("sampler.0.curr-depth") == 4
+    assert hal.getp("sampler.0.curr-depth") == 5      # the depth
     assert hal.getp("sampler.0.full") is True
     assert hal.getp("sampler.0.overruns") == 2
     # as in the reference, sample-num is not advanced by sampler (the
@@ -236,12 +243,13 @@ def test_sampler_records_each_cycle_exactly(hal):
     assert s.read() == (4, (7 / 4, True, -7, 21, -(7 << 40)))
     hal.setp("sampler.0.enable", False)
     hal.step(5)
-    assert s.depth == 0 and hal.getp("sampler.0.curr-depth") == 1
+    # as the reference: while disabled, curr-depth follows the reader
+    assert s.depth == 0 and hal.getp("sampler.0.curr-depth") == 0
     assert hal.getp("sampler.0.overruns") == 2
 
 
 def test_sampler_overruns_pin_can_be_reset(hal):
-    _counting_sampler(hal, depth=1)
+    _counting_sampler(hal, depth=2)   # holds 1 record
     hal.step(4)
     assert hal.getp("sampler.0.overruns") == 3
     hal.setp("sampler.0.overruns", 0)
@@ -503,15 +511,20 @@ def test_streamer_plays_one_record_per_cycle(hal):
     hal.step(2)
     assert hal.getp("streamer.0.pin.2") == -3
     assert hal.getp("streamer.0.underruns") == 0
-    hal.step(2)                       # empty: the pins keep their values
+    hal.step(2)                       # empty: the pins keep their values,
+    # the underruns count on the pin only (as the reference's streamer)
     assert hal.getp("streamer.0.pin.2") == -3
     assert hal.getp("streamer.0.empty") is True
     assert hal.getp("streamer.0.underruns") == 2
     assert hal.getp("streamer.0.curr-depth") == 0
+    assert s.underruns == 0
     hal.setp("streamer.0.enable", False)
     s.write([9.0, 0, 9, 9])
     hal.step(3)
     assert s.depth == 1 and hal.getp("streamer.0.pin.2") == -3
+    # curr-depth and empty follow the FIFO while disabled
+    assert hal.getp("streamer.0.curr-depth") == 1
+    assert hal.getp("streamer.0.empty") is False
     assert hal.getp("streamer.0.underruns") == 2
     hal.setp("streamer.0.enable", True)
     hal.step(1)
@@ -585,8 +598,10 @@ def test_halstreamer_waits_while_the_fifo_is_full(hal, tmp_path):
             if hal.getp("streamer.0.curr-depth") == 0 and \
                     hal.stream("streamer.0").depth == 0:
                 time.sleep(0.01)
+            underruns = hal.getp("streamer.0.underruns")
             hal.step(1)
-            if not hal.getp("streamer.0.empty"):
+            # a cycle plays a record or counts an underrun
+            if hal.getp("streamer.0.underruns") == underruns:
                 seen.append(hal.getp("streamer.0.pin.0"))
         assert proc.wait(timeout=20) == 0
     finally:

@@ -144,8 +144,9 @@ typedef struct {
  * A stream: a single-producer single-consumer FIFO of records (hal_stream.c).
  * The ring follows the record in the same block.  A record is one 64-bit
  * sample number followed by nelem 8-byte values.  The indices only grow;
- * slot = index % depth.  Only the writer stores write_idx and sampleno,
- * only the reader stores read_idx.
+ * slot = index % depth; it holds depth - 1 records (hal_stream.c).  Only
+ * the writer stores write_idx and sampleno, only the reader stores
+ * read_idx.
  */
 #define HAL_STREAM_MAX_ELEMS 256
 
@@ -361,6 +362,7 @@ int hal_stream_read(long long handle, halsdk_value_t *rec,
                     uint64_t *sampleno);
 int hal_stream_depth(long long handle);
 int hal_stream_maxdepth(long long handle);
+int hal_stream_room(long long handle);
 long long hal_stream_num_overruns(long long handle);
 long long hal_stream_num_underruns(long long handle);
 int hal_stream_nelem(long long handle);

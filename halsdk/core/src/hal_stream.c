@@ -10,6 +10,10 @@
  * record once it sees the index (acquire load).  Nothing on that path
  * allocates, locks or makes a system call.
  *
+ * A stream of depth D holds D - 1 records, as the reference's streams do
+ * (its rings keep one slot empty): `loadrt sampler depth=D`, halstreamer
+ * and the Python hal.stream see full and empty where the reference does.
+ *
  * Streams are held by handle (hal_handle_get, hal_core.h).
  */
 #define _GNU_SOURCE
@@ -58,6 +62,12 @@ int hal_stream_parse_types(const char *typestring, uint8_t *types,
 hal_stream_t *hal_stream_get(long long handle)
 {
     return hal_handle_get(handle, K_STREAM, sizeof(hal_stream_t));
+}
+
+/* records a stream holds at most: the one place of that rule */
+static inline uint64_t capacity(const hal_stream_t *s)
+{
+    return s->depth > 1 ? (uint64_t)s->depth - 1 : 0;
 }
 
 static int stale(void)
@@ -128,7 +138,7 @@ int hal_stream_write(long long handle, const halsdk_value_t *rec)
         return stale();
     uint64_t w = __atomic_load_n(&s->write_idx, __ATOMIC_RELAXED);
     uint64_t r = __atomic_load_n(&s->read_idx, __ATOMIC_ACQUIRE);
-    if (w - r >= (uint64_t)s->depth) {
+    if (w - r >= capacity(s)) {
         __atomic_fetch_add(&s->num_overruns, 1, __ATOMIC_RELAXED);
         return -ENOSPC;
     }
@@ -169,6 +179,17 @@ int hal_stream_depth(long long handle)
     uint64_t r = __atomic_load_n(&s->read_idx, __ATOMIC_ACQUIRE);
     uint64_t w = __atomic_load_n(&s->write_idx, __ATOMIC_ACQUIRE);
     return w >= r ? (int)(w - r) : 0;
+}
+
+int hal_stream_room(long long handle)
+{
+    hal_stream_t *s = hal_stream_get(handle);
+    if (!s)
+        return stale();
+    uint64_t r = __atomic_load_n(&s->read_idx, __ATOMIC_ACQUIRE);
+    uint64_t w = __atomic_load_n(&s->write_idx, __ATOMIC_ACQUIRE);
+    uint64_t used = w >= r ? w - r : 0;
+    return used >= capacity(s) ? 0 : (int)(capacity(s) - used);
 }
 
 int hal_stream_maxdepth(long long handle)

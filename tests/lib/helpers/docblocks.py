@@ -27,3 +27,22 @@ def code_blocks(page: Path, language: str) -> list[str]:
             i += 1
         blocks.append(textwrap.dedent("\n".join(body)).strip() + "\n")
     return blocks
+
+
+def fenced_blocks(page: Path, language: str) -> list[str]:
+    """The bodies of the fenced code blocks (three backquotes and
+    LANGUAGE) of a Markdown ``page``, in page order."""
+    lines = page.read_text(encoding="utf-8").splitlines()
+    blocks = []
+    i = 0
+    while i < len(lines):
+        if lines[i].strip() != f"```{language}":
+            i += 1
+            continue
+        i += 1
+        body = []
+        while i < len(lines) and lines[i].strip() != "```":
+            body.append(lines[i])
+            i += 1
+        blocks.append("\n".join(body).strip() + "\n")
+    return blocks
