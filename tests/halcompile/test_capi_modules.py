@@ -242,3 +242,30 @@ def test_halsdk_additions_and_userspace_getters(tmp_path):
     assert proc.stdout.splitlines() == ["3", "-4", "TRUE"], proc.stderr
     assert proc.returncode == 1
     assert "CAPIPLUS: bad arg x" in proc.stderr
+
+
+def test_rtapi_shmem_of_a_module_is_hal_shm_of_python(tmp_path):
+    """A block a C module made with ``rtapi_shmem_new(KEY, ...)`` is the
+    block a Python program attaches with ``hal.shm(comp, KEY, size)``, as
+    in the reference (one key space)."""
+    work = tmp_path / "capi-signals"
+    shutil.copytree(os.path.join(FOLDERS, "capi-signals"), work)
+    assert run(["halcompile", "--compile", "capisig.c"],
+               work).returncode == 0
+    (work / "reader.py").write_text(textwrap.dedent("""\
+        import struct
+        import hal
+        c = hal.component("reader")
+        c.ready()
+        block = hal.shm(c, 0x43415049, 8)
+        magic, cycles = struct.unpack("<II", bytes(block.getbuffer()[:8]))
+        print(f"magic {magic:#x} running {cycles > 0}")
+        c.exit()
+        """))
+    (work / "shm.hal").write_text(
+        "loadrt capisig\nloadrt threads name1=t period1=1000000\n"
+        "addf capisig.update t\nstart\nloadusr -w sleep 0.05\n"
+        f"loadusr -w {sys.executable} reader.py\n")
+    proc = run(["halrun", "-f", "shm.hal"], work, HALSDK_PATH=str(work))
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.splitlines() == ["magic 0x1234 running True"]

@@ -68,7 +68,8 @@ static int export_symbols(void)
 }
 
 /* ---------------------------------------------- rtapi_shmem_* (rtapi.h)
-   A block of key K is the instance's shared block "rtapi-shmem-K" (hex);
+   A block of key K is the instance's shared block "shm.KKKKKKKK" (hex,
+   the name the Python hal.shm(comp, K, size) of halsdk.compat uses too);
    the module knows it by an id, its index in this table plus one. */
 #define MAX_SHMEM 64
 static long long shmem_handle[MAX_SHMEM];      /* handle + 1; 0: free */
@@ -78,7 +79,7 @@ int rtapi_shmem_new(int key, int module_id, unsigned long int size)
     char name[32];
     if (size == 0 || size > (unsigned long)LONG_MAX)
         return -EINVAL;
-    snprintf(name, sizeof(name), "rtapi-shmem-%08x", (unsigned)key);
+    snprintf(name, sizeof(name), "shm.%08x", (unsigned)key);
     long long h = halsdk_api_ptr->shmem_attach(name);
     if (h < 0) {
         h = halsdk_api_ptr->shmem_new(name, module_id, (long)size);
