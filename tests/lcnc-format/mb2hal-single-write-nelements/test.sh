@@ -1,13 +1,6 @@
 #!/bin/bash
-# start the Modbus simulator on a free loopback port; fill @PORT@ in x.ini
-export HALSDK_INSTANCE=${HALSDK_INSTANCE:-lcnc}-mb$$
-rm -f port log x.ini out
-${PYTHON:-python3} ../../../examples/modbus/simulator.py --port 0 \
-    --port-file port --log log > /dev/null 2>&1 &
-SIM=$!
-trap 'kill $SIM 2>/dev/null; wait $SIM 2>/dev/null; rm -f port log x.ini out' EXIT
-for i in $(seq 100); do [ -s port ] && break; sleep 0.1; done
-sed "s/@PORT@/$(cat port)/" x.ini.in > x.ini
+# the Modbus simulator on a free loopback port; x.ini from x.ini.in
+. ../lib/modbus-simulator.sh
 cat > test.hal <<'HAL'
 loadusr -W mb2hal config=x.ini
 setp mb2hal.pair.00.int 11
