@@ -38,11 +38,17 @@ def main(argv: Optional[list[str]] = None) -> int:
                           "steps the servo thread every task cycle "
                           "(a simulation that runs the same on any "
                           "machine load)")
+    run.add_argument("--strict", action="store_true",
+                     help="refuse to start when the INI file has a problem "
+                          "that is otherwise a warning: an unknown key of "
+                          "a LinuxCNC section (a typo), a section or key "
+                          "given twice, [KINS]JOINTS that disagrees with "
+                          "the [JOINT_n] sections or the HAL files")
     a = p.parse_args(args)
     if a.command == "run":
         from halsdk.machine.launcher import run as run_machine
         return run_machine(a.ini, seconds=a.seconds,
-                           realtime=not a.stepped)
+                           realtime=not a.stepped, strict=a.strict)
     return 2
 
 

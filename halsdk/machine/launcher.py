@@ -3,7 +3,10 @@
 What the launcher does, in order:
 
 1. reads the INI file; a missing ``[HAL]HALFILE`` is an error naming the
-   file;
+   file; checks it for typing mistakes (:mod:`halsdk.machine.inicheck`:
+   unknown keys of LinuxCNC's sections, repeated sections and keys,
+   ``[KINS]JOINTS`` against the ``[JOINT_n]`` sections), each a warning
+   on ``err``, or with ``strict`` an error before anything is started;
 2. creates the HAL instance (this process is its host); when the INI file
    has an ``[EMCIO]`` section, makes the I/O controller ``iocontrol.0``
    (:class:`halsdk.machine.IoControl`, its tool table from
@@ -14,7 +17,10 @@ What the launcher does, in order:
    ``[HAL]TWOPASS`` is set) and ``[HAL]HALCMD`` with ``[SECTION]KEY``
    substitution from the INI file; the first error (``file:line: ...``)
    stops the start;
-3. when the HAL files loaded the motion module, configures it from the
+3. when the HAL files loaded the motion module, checks that it has
+   ``[KINS]JOINTS`` joints and that the HAL files wire no joint beyond
+   them (a warning, or with ``strict`` an error that shuts down what was
+   started), then configures it from the
    INI file (:meth:`halsdk.motion.Motion.configure_ini`: [KINS], [TRAJ],
    [JOINT_n], [AXIS_L]); the I/O controller runs in ``servo-thread``;
 4. starts the realtime threads and runs ``[HAL]POSTGUI_HALFILE``;
@@ -63,13 +69,17 @@ class Launcher:
     """One machine started from an INI file (see the module docstring)."""
 
     def __init__(self, ini_path: str, out: TextIO = sys.stdout,
-                 err: TextIO = sys.stderr):
+                 err: TextIO = sys.stderr, strict: bool = False):
         try:
             self.ini = IniFile(ini_path)
         except OSError as e:
             raise LaunchError(f"{ini_path}: cannot read: {e.strerror}"
                               ) from None
         self.out, self.err = out, err
+        #: problems of the INI file are errors (``halsdk run --strict``)
+        self.strict = strict
+        #: the problems found so far (warnings unless strict)
+        self.problems: list[Any] = []
         self.hal: Any = None
         self.motion: Any = None
         self.io: Any = None             # the I/O controller, with [EMCIO]
@@ -94,11 +104,14 @@ class Launcher:
             if not os.access(path, os.R_OK):
                 raise LaunchError(f"{self.ini.where('HAL', 'HALFILE')}: "
                                   f"cannot read HAL file '{name}'")
+        from halsdk.machine.inicheck import check_ini
+        self._report(check_ini(self.ini))
         self.hal = halsdk.Hal(create=True)
         try:
             self._start_io()
             ex = self._executor()
             self._load(ex, halfiles)
+            self._check_joints()
             self._configure_motion()
             if self.io is not None and self.motion is not None:
                 self.io.attach(self.hal, "servo-thread")
@@ -152,6 +165,29 @@ class Launcher:
         if ex.errors != before:
             raise LaunchError(f"{path}: the HAL file failed (see the "
                               "message above)")
+
+    def _report(self, problems: list[Any]) -> None:
+        """Warnings on ``err``; with ``strict`` a LaunchError that lists
+        them."""
+        if not problems:
+            return
+        self.problems.extend(problems)
+        if self.strict:
+            n = len(problems)
+            raise LaunchError(
+                f"{self.ini.path}: {n} problem{'s' if n > 1 else ''} in the "
+                "INI file (--strict: the machine is not started):\n" +
+                "\n".join(f"  {p}" for p in problems))
+        for p in problems:
+            print(f"warning: {p}", file=self.err, flush=True)
+
+    def _check_joints(self) -> None:
+        try:
+            self.hal.shared_block("motmod.channel")
+        except HalError:
+            return                      # no motion module: no joints
+        from halsdk.machine.inicheck import check_hal_joints
+        self._report(check_hal_joints(self.ini, self.hal))
 
     def _configure_motion(self) -> None:
         try:
@@ -228,13 +264,14 @@ class Launcher:
 
 
 def run(ini_path: str, seconds: Optional[float] = None,
-        realtime: bool = True) -> int:
+        realtime: bool = True, strict: bool = False) -> int:
     """``halsdk run``: start, host the task (when the HAL files load
     motion), run until a signal (or ``seconds``), shut down.  Returns the
-    exit status."""
+    exit status.  ``strict``: problems of the INI file are errors (exit
+    status 1, nothing started)."""
     from halsdk.machine.runner import TaskRunner
     try:
-        machine = Launcher(ini_path)
+        machine = Launcher(ini_path, strict=strict)
         machine.start(realtime=realtime)
     except HalError as e:
         print(f"halsdk run: {e}", file=sys.stderr)
