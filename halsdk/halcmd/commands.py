@@ -16,6 +16,7 @@ import time
 from collections.abc import Iterable
 from typing import Callable, Optional
 
+from halsdk import console
 from halsdk.compat import program_env
 from halsdk.component import Component
 from halsdk.errors import HalError, Rule
@@ -797,6 +798,15 @@ def _discard(text: str) -> None:
 
 def _writer(stream) -> Out:
     def write(text: str) -> None:
-        stream.write(text)
-        stream.flush()
+        try:
+            stream.write(text)
+            stream.flush()
+        except BrokenPipeError:
+            # the reader went away ("halcmd show pin | head -1"): as the
+            # reference, say nothing and run the rest of the file, so a
+            # HAL file is never left half applied; what follows goes to
+            # /dev/null
+            if stream is not sys.stdout:
+                raise
+            console.silence_stdout()
     return write
