@@ -20,7 +20,7 @@ from halsdk import console
 from halsdk.compat import program_env
 from halsdk.component import Component
 from halsdk.errors import HalError, Rule
-from halsdk.hal import Hal
+from halsdk.hal import Hal, is_halcmd_comp
 from halsdk.halcmd.helptext import HELP
 from halsdk.halcmd.lexer import (
     IniFile,
@@ -468,8 +468,13 @@ class CommandRunner:
     def cmd_unloadusr(self, args: list[str]) -> None:
         name = args[0]
         if name == "all":
+            # never this process (halcmd would end itself with SIGTERM)
+            # nor another halcmd session, as in the reference
+            me = os.getpid()
             names = [c.name for c in self.hal.items("component")
-                     if not c.realtime and c.id != self.comp_id]
+                     if not c.realtime and c.id != self.comp_id
+                     and c.pid != me and not is_halcmd_comp(c.name, c.pid)
+                     and not c.name.startswith("__")]
         else:
             comp = self.hal.find("component", name)
             if comp is None:
