@@ -43,6 +43,7 @@ from halcompile.gen_c import MAX_PERSONALITIES, generate
 from halcompile.model import Component
 from halcompile.parser import CompError, parse_file
 from halcompile.sources import generate_source
+from halsdk import console
 
 #: flags of every generated module: its symbols stay private to it
 _PRIVATE = ["-fvisibility=hidden"]
@@ -85,6 +86,12 @@ def _arg_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
+    """Console entry point: :func:`_main` under the broken-pipe rule
+    of every halsdk program (:mod:`halsdk.console`)."""
+    return console.run(_main, argv)
+
+
+def _main(argv: Optional[Sequence[str]] = None) -> int:
     """Run halcompile with ``argv`` (default: ``sys.argv[1:]``); returns
     the exit status (0, or 1 after a user error)."""
     args = _arg_parser().parse_args(argv)

@@ -29,6 +29,12 @@ _HOST_OPS = ("loadrt", "unloadrt", "unload", "newinst", "delinst",
              "step", "loadrt_args")
 
 
+def is_halcmd_comp(name: str, pid: int) -> bool:
+    """Whether a component is the ``halcmd<pid>`` of a halcmd session
+    (``unload all`` and ``unloadusr all`` leave those alone)."""
+    return name == f"halcmd{pid}"
+
+
 class Hal:
     """A HAL instance: create it (become its host) or attach to it.
 
@@ -169,22 +175,38 @@ class Hal:
         A realtime module is unloaded; a userspace component of a live
         process is asked to exit (SIGTERM) and awaited; one whose process
         is gone is removed directly.
-        """
-        self._call_host("unload", name, timeout)
 
-    def _host_unload(self, name: str, timeout: float = 5.0) -> None:
+        ``"all"`` never signals the calling process: its own components
+        are removed directly (halcmd makes its ``halcmd<pid>`` again), and
+        the ``halcmd<pid>`` components of other halcmd sessions are left
+        alone, as in the reference.
+        """
+        self._call_host("unload", name, timeout, caller=os.getpid())
+
+    def _host_unload(self, name: str, timeout: float = 5.0,
+                     caller: Optional[int] = None) -> None:
         registry = self._conn.registry
+        caller = os.getpid() if caller is None else caller
         with self._conn.lock:
             if name == "all":
                 registry.unload_all()
-                users = [c.name for c in _core.items("component")
-                         if c.exists and not c.name.startswith("__")]
+                own, users = [], []
+                for c in _core.items("component"):
+                    if not c.exists or c.name.startswith("__"):
+                        continue
+                    if c.pid == caller:
+                        own.append(c)       # never signal the caller
+                    elif not is_halcmd_comp(c.name, c.pid):
+                        users.append(c.name)
             else:
                 loaded = registry.module_of_comp(name)
                 if loaded is not None or name in registry.modules:
                     registry.unload(loaded.name if loaded else name)
                     return
-                users = [name]
+                own, users = [], [name]
+        for c in own:
+            if c.exists:
+                _core.comp_exit(c.id)
         # waiting for a process to exit must not block other requests
         for comp in users:
             self._remove_user_comp(comp, timeout)

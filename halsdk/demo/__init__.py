@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Optional, TextIO
 
+from halsdk import console
 from halsdk.atomicfile import write_atomic
 
 if TYPE_CHECKING:
@@ -239,6 +240,12 @@ def run(out_png: Optional[str] = "demo.png", realtime: bool = False,
 
 
 def main(argv: Optional[list[str]] = None) -> int:
+    """Console entry point: :func:`_main` under the broken-pipe rule
+    of every halsdk program (:mod:`halsdk.console`)."""
+    return console.run(_main, argv)
+
+
+def _main(argv: Optional[list[str]] = None) -> int:
     parser = argparse.ArgumentParser(prog="halsdk-demo",
                                      description=__doc__.splitlines()[0])
     parser.add_argument("--realtime", action="store_true",

@@ -11,6 +11,7 @@ from __future__ import annotations
 import sys
 from typing import Optional
 
+from halsdk import console
 from halsdk.halcmd.commands import CommandRunner, Quit
 
 _HALCMD_USAGE = """\
@@ -262,6 +263,10 @@ def _teardown(hal, ex: CommandRunner, opts: _Options) -> None:
 
 def halcmd_main(argv: Optional[list[str]] = None) -> int:
     """Entry point of ``halcmd``: attach to the running instance."""
+    return console.run(_halcmd_main, argv)
+
+
+def _halcmd_main(argv: Optional[list[str]] = None) -> int:
     from halsdk import Hal
     from halsdk.errors import HalError
     argv = sys.argv[1:] if argv is None else argv
@@ -289,6 +294,10 @@ def halcmd_main(argv: Optional[list[str]] = None) -> int:
 
 def halrun_main(argv: Optional[list[str]] = None) -> int:
     """Entry point of ``halrun``: create the instance, run, remove it."""
+    return console.run(_halrun_main, argv)
+
+
+def _halrun_main(argv: Optional[list[str]] = None) -> int:
     import halsdk
     from halsdk import Hal
     from halsdk.errors import HalError

@@ -16,10 +16,11 @@ import time
 from collections.abc import Iterable
 from typing import Callable, Optional
 
+from halsdk import console
 from halsdk.compat import program_env
 from halsdk.component import Component
 from halsdk.errors import HalError, Rule
-from halsdk.hal import Hal
+from halsdk.hal import Hal, is_halcmd_comp
 from halsdk.halcmd.helptext import HELP
 from halsdk.halcmd.lexer import (
     IniFile,
@@ -467,8 +468,13 @@ class CommandRunner:
     def cmd_unloadusr(self, args: list[str]) -> None:
         name = args[0]
         if name == "all":
+            # never this process (halcmd would end itself with SIGTERM)
+            # nor another halcmd session, as in the reference
+            me = os.getpid()
             names = [c.name for c in self.hal.items("component")
-                     if not c.realtime and c.id != self.comp_id]
+                     if not c.realtime and c.id != self.comp_id
+                     and c.pid != me and not is_halcmd_comp(c.name, c.pid)
+                     and not c.name.startswith("__")]
         else:
             comp = self.hal.find("component", name)
             if comp is None:
@@ -797,6 +803,15 @@ def _discard(text: str) -> None:
 
 def _writer(stream) -> Out:
     def write(text: str) -> None:
-        stream.write(text)
-        stream.flush()
+        try:
+            stream.write(text)
+            stream.flush()
+        except BrokenPipeError:
+            # the reader went away ("halcmd show pin | head -1"): as the
+            # reference, say nothing and run the rest of the file, so a
+            # HAL file is never left half applied; what follows goes to
+            # /dev/null
+            if stream is not sys.stdout:
+                raise
+            console.silence_stdout()
     return write

@@ -8,8 +8,16 @@ import argparse
 import sys
 from typing import Optional
 
+from halsdk import console
+
 
 def main(argv: Optional[list[str]] = None) -> int:
+    """Console entry point: :func:`_main` under the broken-pipe rule
+    of every halsdk program (:mod:`halsdk.console`)."""
+    return console.run(_main, argv)
+
+
+def _main(argv: Optional[list[str]] = None) -> int:
     args = sys.argv[1:] if argv is None else argv
     if args and args[0] == "ctl":
         # its own parser: options before and after its commands

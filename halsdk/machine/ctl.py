@@ -24,6 +24,7 @@ import time
 from collections.abc import Sequence
 from typing import Any, Callable, Optional, TextIO
 
+from halsdk import console
 from halsdk.errors import HalError, InvalidError
 from halsdk.machine.client import (
     ChannelError,
@@ -514,13 +515,12 @@ def main(argv: Optional[Sequence[str]] = None, *,
         _say(err, e)
         return EXIT_FAILED
     except BrokenPipeError:
-        # the reader went away (`... | head`): nothing more to say
-        try:
-            devnull = os.open(os.devnull, os.O_WRONLY)
-            os.dup2(devnull, out.fileno())
-        except (OSError, ValueError):
-            pass
-        return EXIT_DONE
+        # the reader went away (`... | head`): the rule of every
+        # console script (halsdk.console)
+        if out is not sys.stdout:
+            raise
+        console.silence_stdout()
+        return console.EXIT_BROKEN_PIPE
     except Exception as e:             # a bug: say it in one line
         _say(err, f"internal error: {type(e).__name__}: {e}")
         return EXIT_FAILED

@@ -47,12 +47,12 @@ is reported on standard error with exit status 1.
 from __future__ import annotations
 
 import math
-import os
 import sys
 import time
 from collections.abc import Sequence
 from typing import Any, NamedTuple, Optional
 
+from halsdk import console
 from halsdk.tools._attach import attach, stop_on_signals
 
 PROG = "halmeter"
@@ -185,6 +185,12 @@ def meter(item, out, count: int, period_s: float, stop: list) -> int:
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
+    """Console entry point: :func:`_main` under the broken-pipe rule
+    of every halsdk program (:mod:`halsdk.console`)."""
+    return console.run(_main, argv)
+
+
+def _main(argv: Optional[Sequence[str]] = None) -> int:
     """Entry point of the ``halmeter`` program."""
     if argv is None:
         argv = sys.argv[1:]
@@ -227,11 +233,6 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
             print(f"{PROG}: ERROR: {what} '{opts.name}' was deleted",
                   file=sys.stderr)
             return 1
-        except BrokenPipeError:
-            # the reader went away (e.g. "| head"): a normal end
-            devnull = os.open(os.devnull, os.O_WRONLY)
-            os.dup2(devnull, sys.stdout.fileno())
-            os.close(devnull)
         return 0
     finally:
         hal.close()

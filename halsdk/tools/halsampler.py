@@ -20,6 +20,7 @@ import time
 from collections.abc import Sequence
 from typing import IO, Optional
 
+from halsdk import console
 from halsdk.tools._attach import attach, stop_on_signals
 
 PROG = "halsampler"
@@ -117,6 +118,12 @@ def copy_records(stream, out: IO[str], count: int, tag: bool,
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
+    """Console entry point: :func:`_main` under the broken-pipe rule
+    of every halsdk program (:mod:`halsdk.console`)."""
+    return console.run(_main, argv)
+
+
+def _main(argv: Optional[Sequence[str]] = None) -> int:
     """Entry point of the ``halsampler`` program."""
     if argv is None:
         argv = sys.argv[1:]
@@ -153,8 +160,6 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
             out.flush()
             print(f"{PROG}: ERROR: stream '{name}' was removed (sampler "
                   "unloaded)", file=sys.stderr)
-            return 1
-        except BrokenPipeError:
             return 1
         finally:
             if filename:

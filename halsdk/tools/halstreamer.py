@@ -23,6 +23,7 @@ import time
 from collections.abc import Iterable, Sequence
 from typing import IO, Optional
 
+from halsdk import console
 from halsdk.tools._attach import attach, stop_on_signals
 from halsdk.values import c_float, c_wrap
 
@@ -137,6 +138,12 @@ def feed(stream, lines: Iterable[str], stop: list,
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
+    """Console entry point: :func:`_main` under the broken-pipe rule
+    of every halsdk program (:mod:`halsdk.console`)."""
+    return console.run(_main, argv)
+
+
+def _main(argv: Optional[Sequence[str]] = None) -> int:
     """Entry point of the ``halstreamer`` program."""
     if argv is None:
         argv = sys.argv[1:]
