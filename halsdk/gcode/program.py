@@ -18,9 +18,8 @@ from .params import Parameters
 #: Default limit of the control-flow work of one run of a program: loop
 #: iterations (every entry into the body of a while, do or repeat loop, of
 #: every loop, nested or not, counted together) plus subroutine calls.
-#: A real program whose loops move the machine stays far below it (a
-#: million moves take hours); a loop that spins without an end reaches it
-#: in about a second.
+#: Ten times a loop of 100,000 moves, which is already a long job; a loop
+#: that spins without an end reaches it in about a second.
 MAX_ITERATIONS = 1_000_000
 
 #: Default limit, in seconds, of the time the control flow may run without
