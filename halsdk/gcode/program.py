@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import os
 import re
-from collections.abc import Iterator, Sequence
+import time
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from typing import Optional
 
@@ -14,8 +15,17 @@ from .expr import Expr, ParamRef, Where
 from .lexer import Line, OWord, parse_line
 from .params import Parameters
 
-#: Default limit of iterations of one loop before it counts as endless.
-MAX_ITERATIONS = 100_000
+#: Default limit of the control-flow work of one run of a program: loop
+#: iterations (every entry into the body of a while, do or repeat loop, of
+#: every loop, nested or not, counted together) plus subroutine calls.
+#: Ten times a loop of 100,000 moves, which is already a long job; a loop
+#: that spins without an end reaches it in about a second.
+MAX_ITERATIONS = 1_000_000
+
+#: Default limit, in seconds, of the time the control flow may run without
+#: handing the interpreter a block that does something (a code, a word or
+#: a message): the time the consumer spends on blocks is not counted.
+MAX_IDLE_TIME = 5.0
 
 #: Default limit of nested subroutine calls.
 MAX_CALL_DEPTH = 64
@@ -190,6 +200,13 @@ class Program:
     searched for ``<name>.ngc`` when ``o<name> call`` names no subroutine
     of the program.  With ``block_delete=True`` lines starting with '/'
     are skipped; otherwise they are yielded with ``block_delete`` set.
+
+    Runaway control flow is an error (a :class:`GCodeError` at the line of
+    the loop or call): one run may do at most ``max_iterations`` loop
+    iterations and subroutine calls in total (all loops and calls counted
+    together; :attr:`iterations` is the count), and its control flow may
+    run at most ``max_idle_time`` seconds (measured with ``clock``)
+    without handing out a block that has a code, a word or a message.
     """
 
     def __init__(self, text: str, file: str = "<string>",
@@ -197,13 +214,27 @@ class Program:
                  search_path: Sequence[str] = (), *,
                  block_delete: bool = False,
                  max_iterations: int = MAX_ITERATIONS,
-                 max_call_depth: int = MAX_CALL_DEPTH) -> None:
+                 max_idle_time: float = MAX_IDLE_TIME,
+                 max_call_depth: int = MAX_CALL_DEPTH,
+                 clock: Callable[[], float] = time.monotonic) -> None:
+        if not max_iterations >= 1:
+            raise ValueError(f"max_iterations must be at least 1, not "
+                             f"{max_iterations!r}")
+        if not max_idle_time > 0:
+            raise ValueError(f"max_idle_time must be more than 0 s, not "
+                             f"{max_idle_time!r}")
         self.file = file
         self.params = params if params is not None else Parameters()
         self.search_path = list(search_path)
         self.block_delete = block_delete
-        self.max_iterations = max_iterations
+        self.max_iterations = int(max_iterations)
+        self.max_idle_time = float(max_idle_time)
         self.max_call_depth = max_call_depth
+        self.clock = clock
+        #: loop iterations and subroutine calls of the current (or last)
+        #: run of :meth:`blocks`; never more than ``max_iterations``
+        self.iterations = 0
+        self._idle_since = 0.0
         self._frames: list[_Frame] = []
         self._main = _Unit(text, file)
         self._files: dict[str, _Unit] = {}
@@ -315,6 +346,8 @@ class Program:
         """The blocks in execution order (see the class docstring); ends at
         M2/M30, the closing '%' or the end of the file."""
         self.params.reset_scopes()
+        self.iterations = 0
+        self._idle_since = self.clock()
         try:
             yield from self._run()
         finally:
@@ -326,8 +359,8 @@ class Program:
         frames: list[_Frame] = []
         self._frames = frames
         repeats: dict[tuple[int, int], int] = {}
-        counts: dict[tuple[int, int], int] = {}
         seen_code = False
+        clock = self.clock
         while True:
             if index >= len(unit.lines):
                 if frames:  # pragma: no cover - the scan rules it out
@@ -362,9 +395,15 @@ class Program:
                 if line.words:
                     seen_code = True
                 block = self._block(line)
-                if block.g or block.m or block.words or block.comments \
-                        or block.message is not None:
+                working = bool(block.g or block.m or block.words
+                               or block.message is not None)
+                if working or block.comments:
+                    handed = clock()
                     yield block
+                    if working:
+                        self._idle_since = clock()
+                    else:   # the time the consumer held it is not idle
+                        self._idle_since += clock() - handed
                 if any(abs(m - 2) < 1e-6 or abs(m - 30) < 1e-6
                        for m in block.m):
                     return
@@ -372,10 +411,6 @@ class Program:
             seen_code = True
             keyword = oword.keyword
             frame_key = id(frames[-1]) if frames else 0
-
-            def loop_guard(opener: int, _unit: _Unit = unit,
-                           _key: int = frame_key) -> None:
-                self._count(counts, (_key, opener), _unit, opener)
 
             if keyword == "call":
                 name = oword.name if isinstance(oword.name, str) else \
@@ -388,6 +423,7 @@ class Program:
                     raise GCodeError(f"subroutine calls nested deeper than "
                                      f"{self.max_call_depth}", line.file,
                                      line.number, oword.column)
+                self._count(unit, index, "subroutine call")
                 args = [self._value(a, line) for a in oword.args]
                 if len(args) > 30:
                     raise GCodeError("at most 30 subroutine arguments",
@@ -405,8 +441,8 @@ class Program:
                     if oword.args else None
                 frame = frames.pop()
                 self.params.pop_scope()
-                for key in [k for k in counts if k[0] == id(frame)]:
-                    del counts[key]
+                for key in [k for k in repeats if k[0] == id(frame)]:
+                    del repeats[key]
                 if returned is not None:
                     self.params.set("_value", returned)
                     self.params.set("_value_returned", 1.0)
@@ -425,19 +461,18 @@ class Program:
                 # the closing "while" of a do loop
                 opener = structure.loop_start[index]
                 if self._value(oword.args[0], line):
-                    loop_guard(opener)
+                    self._count(unit, opener, "loop")
                     index = opener + 1
                 else:
-                    counts.pop((frame_key, opener), None)
                     index += 1
             elif keyword == "while":
                 if self._value(oword.args[0], line):
-                    loop_guard(index)
+                    self._count(unit, index, "loop")
                     index += 1
                 else:
-                    counts.pop((frame_key, index), None)
                     index = structure.loop_end[index] + 1
             elif keyword == "do":
+                self._count(unit, index, "loop")
                 index += 1
             elif keyword == "repeat":
                 count = int(self._value(oword.args[0], line))
@@ -445,23 +480,23 @@ class Program:
                 if count <= 0:
                     index = structure.loop_end[index] + 1
                 else:
-                    loop_guard(index)
+                    self._count(unit, index, "loop")
                     index += 1
             elif keyword == "endrepeat":
                 opener = structure.loop_start[index]
                 key = (frame_key, opener)
                 repeats[key] -= 1
                 if repeats[key] > 0:
-                    loop_guard(opener)
+                    self._count(unit, opener, "loop")
                     index = opener + 1
                 else:
-                    counts.pop(key, None)
+                    del repeats[key]
                     index += 1
             elif keyword == "endwhile":
                 index = structure.loop_start[index]
             elif keyword == "break":
                 opener = structure.loop_of[index]
-                counts.pop((frame_key, opener), None)
+                repeats.pop((frame_key, opener), None)
                 index = structure.loop_end[opener] + 1
             elif keyword == "continue":
                 opener = structure.loop_of[index]
@@ -471,17 +506,32 @@ class Program:
                 raise GCodeError(f"unsupported o-word {keyword}", line.file,
                                  line.number, oword.column)
 
-    def _count(self, counts: dict[tuple[int, int], int],
-               key: tuple[int, int], unit: _Unit, opener: int) -> None:
-        """Count one more iteration of a loop; too many is an error."""
-        counts[key] = counts.get(key, 0) + 1
-        if counts[key] > self.max_iterations:
-            start = unit.lines[opener]
-            assert isinstance(start, Line) and start.oword
-            raise GCodeError(
-                f"loop did not end after {self.max_iterations} "
-                "iterations (endless loop?)", start.file, start.number,
-                start.oword.column)
+    def _count(self, unit: _Unit, index: int, what: str) -> None:
+        """Count one more loop iteration or subroutine call of this run
+        (line ``index`` of ``unit``); past a limit it is an error."""
+        if self.iterations >= self.max_iterations:
+            raise self._runaway(
+                unit, index,
+                f"{what} exceeds the limit of {self.max_iterations} loop "
+                "iterations and subroutine calls in one run (endless "
+                "loop?); raise it with Program(max_iterations=...) or "
+                "[RS274NGC]HALSDK_MAX_ITERATIONS")
+        self.iterations += 1
+        idle = self.clock() - self._idle_since
+        if idle > self.max_idle_time:
+            raise self._runaway(
+                unit, index,
+                f"{what} ran {idle:.3g} s without a block to execute, "
+                f"more than the limit of {self.max_idle_time:g} s "
+                "(endless loop?); raise it with Program(max_idle_time=...)"
+                " or [RS274NGC]HALSDK_MAX_IDLE_TIME")
+
+    @staticmethod
+    def _runaway(unit: _Unit, index: int, message: str) -> GCodeError:
+        line = unit.lines[index]
+        assert isinstance(line, Line) and line.oword is not None
+        return GCodeError(message, line.file, line.number,
+                          line.oword.column)
 
     def _choose_branch(self, unit: _Unit, index: int, line: Line) -> int:
         """The line to continue at after ``O.. if`` at ``index``."""

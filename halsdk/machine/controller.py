@@ -26,6 +26,7 @@ also posted on the error channel: the reference ignores many silently.
 from __future__ import annotations
 
 import copy
+import math
 import os
 from collections import deque
 from collections.abc import Iterator
@@ -69,6 +70,7 @@ from halsdk.errors import HalError
 from halsdk.gcode import GCodeError, Parameters, Program
 from halsdk.gcode.cutter_radius import CutterComp
 from halsdk.gcode.interp import Interpreter
+from halsdk.gcode.program import MAX_IDLE_TIME, MAX_ITERATIONS
 from halsdk.machine.executor import Executor
 from halsdk.machine.iocontrol import IoControl
 from halsdk.machine.snapshot import build_snapshot
@@ -121,6 +123,25 @@ class _Job:
         self.error: Optional[str] = None
 
 
+def _ini_limit(ini: Any, key: str, default: float, whole: bool) -> float:
+    """The halsdk-specific [RS274NGC]key: a number above 0 (a whole one
+    when ``whole``); ``default`` when the key is absent."""
+    text = ini.get("RS274NGC", key)
+    if text is None or not str(text).strip():
+        return default
+    try:
+        value = float(str(text).split()[0])
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and value > 0) or \
+            whole and not value.is_integer():
+        what = "a whole number above 0" if whole else \
+            "a number of seconds above 0"
+        raise MachineError(f"{ini.where('RS274NGC', key)}: {key} "
+                           f"'{text}' is not {what}")
+    return value
+
+
 class TaskController:
     """The task level of one machine (see the module docstring).
 
@@ -147,6 +168,11 @@ class TaskController:
         self.subroutine_path: list[str] = []
         #: [RS274NGC]PARAMETER_FILE: persistent parameters (var file)
         self.parameter_file: Optional[str] = None
+        #: the bounds of runaway control flow of every program and MDI
+        #: line run (halsdk-specific [RS274NGC]HALSDK_MAX_ITERATIONS and
+        #: HALSDK_MAX_IDLE_TIME; see :class:`halsdk.gcode.Program`)
+        self.max_iterations = MAX_ITERATIONS
+        self.max_idle_time = MAX_IDLE_TIME
         #: the INI file of the machine (status ``ini_filename``)
         self.ini_filename = ""
         self.units = units
@@ -188,7 +214,9 @@ class TaskController:
 
     def configure_from_ini(self, ini: Any) -> None:
         """[RS274NGC]SUBROUTINE_PATH and PARAMETER_FILE, relative to the
-        INI file's folder; the parameters are read from the file."""
+        INI file's folder; the parameters are read from the file.  The
+        halsdk-specific [RS274NGC]HALSDK_MAX_ITERATIONS and
+        HALSDK_MAX_IDLE_TIME set the bounds of runaway control flow."""
         self.ini_filename = os.path.abspath(ini.path)
         coords = str(ini.get("TRAJ", "COORDINATES") or "").upper()
         letters = [c for c in coords if c in "XYZABCUVW"]
@@ -201,6 +229,10 @@ class TaskController:
             self.subroutine_path = [
                 os.path.join(folder, p.strip()) for p in paths.split(":")
                 if p.strip()]
+        self.max_iterations = int(_ini_limit(
+            ini, "HALSDK_MAX_ITERATIONS", self.max_iterations, True))
+        self.max_idle_time = _ini_limit(
+            ini, "HALSDK_MAX_IDLE_TIME", self.max_idle_time, False)
         name = ini.get("RS274NGC", "PARAMETER_FILE")
         if name:
             self.parameter_file = os.path.join(folder, name)
@@ -431,7 +463,9 @@ class TaskController:
     def _start_mdi(self, line: str, t: Ticket) -> None:
         job = _Job(t, "<mdi>")
         program = Program(line, "<mdi>", self.params,
-                          block_delete=self.block_delete)
+                          block_delete=self.block_delete,
+                          max_iterations=self.max_iterations,
+                          max_idle_time=self.max_idle_time)
         self._running = program
         self._start_job(job, program.blocks())
         self.last_command = line
@@ -500,7 +534,9 @@ class TaskController:
         try:
             program = Program.from_file(self.file, self.params,
                                         self.subroutine_path,
-                                        block_delete=self.block_delete)
+                                        block_delete=self.block_delete,
+                                        max_iterations=self.max_iterations,
+                                        max_idle_time=self.max_idle_time)
         except OSError as e:
             raise MachineError(f"program run: {self.file}: {e.strerror}"
                                ) from None

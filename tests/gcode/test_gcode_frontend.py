@@ -352,7 +352,8 @@ def test_expressions_see_parameters_set_during_iteration() -> None:
 def test_endless_loop_is_an_error_naming_the_loop() -> None:
     message = error_of("g0 x0\n  o7 while [1]\n  o7 endwhile\n",
                        max_iterations=50)
-    assert message.startswith("t.ngc:2:3: loop did not end after 50")
+    assert message.startswith("t.ngc:2:3: loop exceeds the limit of 50 "
+                              "loop iterations and subroutine calls")
 
 
 # -- errors --------------------------------------------------------------------

@@ -215,6 +215,47 @@ def test_errors_name_file_and_line(machine, tmp_path):
         m.wait_program(timeout=10)
 
 
+def test_a_runaway_loop_is_reported_like_other_gcode_errors(machine,
+                                                             tmp_path):
+    from halsdk.ini import IniFile
+    m = machine
+    ini = tmp_path / "limits.ini"
+    ini.write_text("[RS274NGC]\nHALSDK_MAX_ITERATIONS = 500\n"
+                   "HALSDK_MAX_IDLE_TIME = 2.5\n")
+    m.configure_from_ini(IniFile(str(ini)))
+    assert (m.max_iterations, m.max_idle_time) == (500, 2.5)
+    turn_on(m)
+    path = tmp_path / "spin.ngc"
+    path.write_text("G21 G90 G0 X1\no1 repeat [99999]\n  o2 repeat [99999]"
+                    "\n  o2 endrepeat\no1 endrepeat\nM2\n")
+    m.mode(TaskMode.AUTO)
+    m.program_open(str(path))
+    m.program_run()
+    with pytest.raises(MachineError) as e:
+        m.wait_program(timeout=10)
+    assert str(e.value).startswith(f"{path}:3:3: loop exceeds the limit "
+                                   "of 500 loop iterations")
+    assert any(k == "error" and t == str(e.value) for k, t in m.errors())
+    st = m.status()
+    assert st.interp_state is InterpState.IDLE
+    assert st.task_state is TaskState.ESTOP_RESET and not st.enabled
+
+
+@pytest.mark.parametrize("entry, why", [
+    ("HALSDK_MAX_ITERATIONS = 0", "is not a whole number above 0"),
+    ("HALSDK_MAX_ITERATIONS = 2.5", "is not a whole number above 0"),
+    ("HALSDK_MAX_IDLE_TIME = -1", "is not a number of seconds above 0"),
+    ("HALSDK_MAX_IDLE_TIME = soon", "is not a number of seconds above 0"),
+])
+def test_bad_control_flow_limits_in_the_ini_name_the_line(machine, tmp_path,
+                                                          entry, why):
+    from halsdk.ini import IniFile
+    ini = tmp_path / "bad.ini"
+    ini.write_text(f"[RS274NGC]\n{entry}\n")
+    with pytest.raises(MachineError, match=f"bad.ini:2: .* {why}"):
+        machine.configure_from_ini(IniFile(str(ini)))
+
+
 def test_m0_pauses_and_resume_continues(machine, tmp_path):
     m = machine
     turn_on(m)
