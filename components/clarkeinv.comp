@@ -23,10 +23,11 @@ license "GPL";
 #include <rtapi_math.h>
 
 /* one turn in radians, sqrt(3)/2 and 1/sqrt(2), with the reference's precision (its
-   outputs differ from exact ones in the 10th digit) */
+   outputs differ from exact ones in the 10th digit; 1/sqrt(2) is the
+   15-digit 0.707106781186547, seen in the last digits of huge outputs) */
 #define TURN 6.283185308
 #define KS3  0.866025403784439
-#define KH   0.707106781186548
+#define KH   0.707106781186547
 
 FUNCTION(_) {
     double ang = theta * TURN;

@@ -5,7 +5,7 @@ pin in float in1 "Non-inverting input: out goes TRUE when it rises above in0";
 pin out bit out """TRUE when in1 > in0. With hysteresis, out goes TRUE when
 in1 - in0 > hyst/2, goes FALSE when in1 - in0 < -hyst/2 and keeps its state
 in between (also when the inputs are exactly equal and hyst is 0)""";
-pin out bit equal "TRUE when |in1 - in0| <= hyst/2";
+pin out bit equal "TRUE when |in1 - in0| <= hyst/2, and when an input or hyst is NaN (as in LinuxCNC)";
 
 param rw float hyst = 0.0 """Width of the band around in1 = in0 where out keeps
 its state. Rounding makes exact equality unreliable: set hyst to use
@@ -28,5 +28,7 @@ FUNCTION(_) {
         out = 1;
     if (d < -half)
         out = 0;
-    equal = fabs(d) <= half;
+    /* neither test passed: equal, also when d or hyst is NaN (as in
+       LinuxCNC) */
+    equal = !(d > half) && !(d < -half);
 }

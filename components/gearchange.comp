@@ -44,10 +44,12 @@ FUNCTION(_) {
     if (scale2 < 1.0)
         scale2 = 1.0;
 
-    /* limit the size of the command, the lower bound first */
+    /* limit the size of the command: one bound or the other, as in
+       LinuxCNC (with min > max, a command below min gets min, one above
+       it gets max) */
     if (mag < lo)
         mag = lo;
-    if (mag > hi)
+    else if (mag > hi)
         mag = hi;
     if (speed_in < 0)
         mag = -mag;

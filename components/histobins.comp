@@ -102,7 +102,14 @@ FUNCTION(_) {
         for (k = 0; k <= MAXBINS; k++)
             bins[k] = 0;
         pextra = nextra = 0;
-        input_min = input_max = x;
+        /* the extremes start from +-1e99, as in LinuxCNC (an infinite,
+           NaN or huger sample does not replace both) */
+        input_min = 1e99;
+        input_max = -1e99;
+        if (x < input_min)
+            input_min = x;
+        if (x > input_max)
+            input_max = x;
         nsamples = 1;
         mean = variance = 0;
         m2 = sum = sumsq = 0;

@@ -61,6 +61,7 @@ static double brake_dist(double dv, double a, double dt)
 static double stop_speed(double room, double a, double dt)
 {
     double unit = a * dt * dt, r, n, f;
+    int k;
 
     if (room <= 0)
         return room / dt;
@@ -68,10 +69,13 @@ static double stop_speed(double room, double a, double dt)
         return room / dt;
     r = room / unit;
     n = floor((sqrt(8 * r + 1) - 1) / 2);
-    /* rounding of the root: keep n*(n+1)/2 <= r < (n+1)*(n+2)/2 */
-    while (n > 0 && n * (n + 1) / 2 > r)
+    /* rounding of the root: keep n*(n+1)/2 <= r < (n+1)*(n+2)/2; a
+       step or two at most, and none that could loop for ever where n
+       is too large for n + 1 to differ from n (a huge or infinite
+       room or limits) */
+    for (k = 0; k < 4 && n > 0 && n * (n + 1) / 2 > r; k++)
         n--;
-    while ((n + 1) * (n + 2) / 2 <= r)
+    for (k = 0; k < 4 && (n + 1) * (n + 2) / 2 <= r; k++)
         n++;
     f = (r - n * (n + 1) / 2) / (n + 1);
     if (f > 1)

@@ -19,8 +19,11 @@ output that went TRUE stays TRUE.
 
 A press held too long, or a fifth click, ends the multi-click without an
 \\fB-only\\fR pulse; the detector then waits for the button to be released.
-Times are counted in whole thread periods.  A noisy button should go
-through \\fBdebounce\\fR(9) first.
+Times are counted in whole thread periods, by a 32-bit timer as in
+LinuxCNC: it wraps after 4294967296 ns, so a \\fBmax-hold-ns\\fR or
+\\fBmax-space-ns\\fR above 4294967296 minus the period is never passed
+and such a press or release does not end the multi-click.  A noisy
+button should go through \\fBdebounce\\fR(9) first.
 
 \\fBstate\\fR shows the internal state: 0 idle, 1 3 5 7 the first to fourth
 press held, 2 4 6 8 released after the first to fourth click, 9 waiting for
@@ -43,7 +46,7 @@ param rw u32 max_hold_ns = 250000000 "A press held longer than this (in ns) is n
 param rw u32 max_space_ns = 250000000 "A release longer than this (in ns) ends the multi-click; default 250 ms";
 param rw u32 output_hold_ns = 100000000 "Length of the output pulses in ns; default 100 ms";
 
-variable long timer;
+variable rtapi_u32 timer;
 variable long left[8];
 variable int on[8];
 
@@ -88,7 +91,7 @@ FUNCTION(_) {
             st++;
             timer = 0;
         } else {
-            timer += period;
+            timer += (rtapi_u32)period;     /* wraps as the reference's */
             if (timer > max_hold_ns)
                 st = WAIT_RELEASE;
         }
@@ -99,7 +102,7 @@ FUNCTION(_) {
             st = st == 8 ? WAIT_RELEASE : st + 1;
             timer = 0;
         } else {
-            timer += period;
+            timer += (rtapi_u32)period;
             if (timer > max_space_ns) {
                 fire = st - 1;      /* its N-click-only output */
                 st = IDLE;

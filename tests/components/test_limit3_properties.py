@@ -129,3 +129,21 @@ def test_limit3_runaway_against_the_reference(tmp_path: Path):
         assert ours[-1, col] == ref[-1, col] == limits[col - 1][0]
     gap = np.abs(ours - ref).max(axis=0)
     assert (gap[1:] <= [6, 5, 20]).all(), gap
+
+
+def test_limit3_extreme_limits_do_not_hang(hal):
+    """A huge maxv (or room to a bound) made the braking solver loop for
+    ever (n + 1 == n for such n), hanging the thread; found by the
+    differential fuzz.  Every cycle must now return."""
+    setup(hal, "limit3", "limit3.0")
+    hal.set({"limit3.0.min": 0.0, "limit3.0.max": -1.719,
+             "limit3.0.maxa": 5.834, "limit3.0.maxv": -1e300,
+             "limit3.0.in": 17.436})
+    hal.step(3)
+    for maxv, maxa, lo, hi in [(1e300, 1e300, -1e300, 1e300),
+                               (float("inf"), 1.0, -1e300, 1e300),
+                               (1.0, float("inf"), -float("inf"), 0.0)]:
+        hal.set({"limit3.0.min": lo, "limit3.0.max": hi,
+                 "limit3.0.maxv": maxv, "limit3.0.maxa": maxa,
+                 "limit3.0.in": 1e299})
+        hal.step(3)

@@ -384,6 +384,27 @@ def test_multiclick_inverted_input(hal):
     assert tr["multiclick.0.double-click-only"].sum() == 3
 
 
+def test_multiclick_timer_wraps_at_32_bits(hal):
+    """The click timer is 32 bits wide, as the reference's: a limit above
+    2^32 - period is never passed (the timer wraps first), so a release
+    of 4.4 s does not end the click; a limit the timer reaches before it
+    wraps does (tests/data/complib/multiclick-wrap.* against the
+    reference)."""
+    fast_multiclick(hal, count=2)
+    hal.setp("multiclick.0.max-space-ns", 4_294_967_295)
+    hal.setp("multiclick.1.max-space-ns", 4_293_500_000)
+    inp = [1, 1] + [0] * 4400
+    tr = hal.run(len(inp), inputs={"multiclick.0.in": inp,
+                                   "multiclick.1.in": inp},
+                 record=["multiclick.0.single-click-only",
+                         "multiclick.1.single-click-only",
+                         "multiclick.0.state"])
+    assert not tr["multiclick.0.single-click-only"].any()
+    assert (tr["multiclick.0.state"][2:] == 2).all()
+    # 4,293,500,000 ns is passed after 4,294 periods of release
+    assert np.flatnonzero(tr["multiclick.1.single-click-only"])[0] == 2 + 4294
+
+
 # ----------------------------------------------------------- multiswitch
 
 def test_multiswitch_cfg_sizes(hal):

@@ -1,0 +1,248 @@
+"""Property tests of the simple components: whatever the inputs and
+parameters, the outputs keep the component's promise (a limit holds, a
+count matches the edges, an output stays between its inputs...).  Each
+test drives one instance through the stepped Python API, as
+test_limit3_properties.py does for limit3."""
+
+from __future__ import annotations
+
+import numpy as np
+from helpers.components import setup
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+N = 50
+SETTINGS = settings(max_examples=25, deadline=None,
+                    suppress_health_check=[HealthCheck.function_scoped_fixture])
+
+finite = st.floats(-1e6, 1e6, allow_nan=False, allow_infinity=False)
+signal = st.lists(finite, min_size=N, max_size=N)
+bits = st.lists(st.booleans(), min_size=N, max_size=N)
+
+
+def once(hal, comp, funct, args=()):
+    """Load ``comp`` the first time a test's examples run."""
+    if not hal.components(comp):
+        setup(hal, comp, funct, args=args)
+
+
+@SETTINGS
+@given(x=signal, a=finite, b=finite)
+def test_limit1_stays_within(hal, x, a, b):
+    once(hal, "limit1", "limit1.0")
+    lo, hi = min(a, b), max(a, b)
+    hal.set({"limit1.0.min": lo, "limit1.0.max": hi})
+    out = hal.run(N, inputs={"limit1.0.in": np.array(x)},
+                  record=["limit1.0.out"])["limit1.0.out"]
+    assert out.min() >= lo and out.max() <= hi
+    assert (out == np.clip(x, lo, hi)).all()
+
+
+@SETTINGS
+@given(x=signal, a=finite, b=finite, maxv=st.floats(1.0, 1e7))
+def test_limit2_stays_within_and_under_maxv(hal, x, a, b, maxv):
+    once(hal, "limit2", "limit2.0")
+    lo, hi = min(a, b), max(a, b)
+    hal.set({"limit2.0.min": lo, "limit2.0.max": hi,
+             "limit2.0.maxv": maxv, "limit2.0.in": lo,
+             "limit2.0.load": True})
+    hal.step(1)
+    hal.setp("limit2.0.load", False)
+    out = hal.run(N, inputs={"limit2.0.in": np.array(x)},
+                  record=["limit2.0.out"])["limit2.0.out"]
+    out = np.concatenate([[lo], out])
+    assert out.min() >= lo and out.max() <= hi
+    step = np.abs(np.diff(out))
+    assert step.max() <= maxv * 1e-3 * (1 + 1e-9) + 1e-9 * max(abs(lo),
+                                                                abs(hi))
+
+
+@SETTINGS
+@given(x=signal, gain=st.floats(0.0, 1.0))
+def test_lowpass_moves_between_old_output_and_input(hal, x, gain):
+    once(hal, "lowpass", "lowpass.0")
+    hal.set({"lowpass.0.gain": gain, "lowpass.0.in": 0.0,
+             "lowpass.0.load": True})
+    hal.step(1)
+    hal.setp("lowpass.0.load", False)
+    out = hal.run(N, inputs={"lowpass.0.in": np.array(x)},
+                  record=["lowpass.0.out"])["lowpass.0.out"]
+    old = np.concatenate([[0.0], out[:-1]])
+    lo, hi = np.minimum(old, x), np.maximum(old, x)
+    tol = 1e-9 * np.maximum(np.abs(lo), np.abs(hi))
+    assert (out >= lo - tol).all() and (out <= hi + tol).all()
+
+
+@SETTINGS
+@given(x=signal, a=finite, b=finite)
+def test_wcomp_window(hal, x, a, b):
+    once(hal, "wcomp", "wcomp.0")
+    lo, hi = min(a, b), max(a, b)
+    hal.set({"wcomp.0.min": lo, "wcomp.0.max": hi})
+    tr = hal.run(N, inputs={"wcomp.0.in": np.array(x)},
+                 record=["wcomp.0.out", "wcomp.0.over", "wcomp.0.under"])
+    x = np.array(x)
+    assert (tr["wcomp.0.out"] == ((x > lo) & (x < hi))).all()
+    assert (tr["wcomp.0.over"] == (x >= hi)).all()
+    assert (tr["wcomp.0.under"] == (x <= lo)).all()
+
+
+@SETTINGS
+@given(x=signal, center=finite, threshold=st.floats(0.0, 1e6))
+def test_deadzone_zero_inside_and_shifted_outside(hal, x, center,
+                                                  threshold):
+    once(hal, "deadzone", "deadzone.0")
+    hal.set({"deadzone.0.center": center,
+             "deadzone.0.threshold": threshold})
+    out = hal.run(N, inputs={"deadzone.0.in": np.array(x)},
+                  record=["deadzone.0.out"])["deadzone.0.out"]
+    d = np.array(x) - center
+    half = threshold / 2
+    inside = np.abs(d) <= half
+    assert (out[inside] == center).all()
+    # outside: moved towards the center by half the band, never across
+    e = out[~inside] - center
+    assert (np.sign(e) == np.sign(d[~inside])).all()
+    assert np.allclose(np.abs(e), np.abs(d[~inside]) - half,
+                       rtol=1e-9, atol=1e-6)
+
+
+@SETTINGS
+@given(x=signal, reset=bits)
+def test_minmax_tracks_extremes_since_reset(hal, x, reset):
+    once(hal, "minmax", "minmax.0")
+    hal.setp("minmax.0.reset", True)
+    hal.setp("minmax.0.in", x[0])
+    hal.step(1)
+    tr = hal.run(N, inputs={"minmax.0.in": np.array(x),
+                            "minmax.0.reset": np.array(reset)},
+                 record=["minmax.0.min", "minmax.0.max"])
+    lo = hi = x[0]
+    for k in range(N):
+        if reset[k]:
+            lo = hi = x[k]
+        lo, hi = min(lo, x[k]), max(hi, x[k])
+        assert tr["minmax.0.min"][k] == lo and tr["minmax.0.max"][k] == hi
+
+
+@SETTINGS
+@given(x=signal, hold=bits)
+def test_sample_hold_holds(hal, x, hold):
+    once(hal, "sample_hold", "sample-hold.0")
+    tr = hal.run(N, inputs={"sample-hold.0.in": np.array(x).round(),
+                            "sample-hold.0.hold": np.array(hold)},
+                 record=["sample-hold.0.out"])["sample-hold.0.out"]
+    prev = None
+    for k in range(N):
+        if hold[k]:
+            if prev is not None:
+                assert tr[k] == prev
+        else:
+            assert tr[k] == round(x[k])
+        prev = tr[k]
+
+
+@SETTINGS
+@given(x=signal, gain=st.floats(-1e3, 1e3), offset=finite)
+def test_scale_is_affine(hal, x, gain, offset):
+    once(hal, "scale", "scale.0")
+    hal.set({"scale.0.gain": gain, "scale.0.offset": offset})
+    out = hal.run(N, inputs={"scale.0.in": np.array(x)},
+                  record=["scale.0.out"])["scale.0.out"]
+    assert np.allclose(out, np.array(x) * gain + offset, rtol=1e-12,
+                       atol=1e-6)
+
+
+@SETTINGS
+@given(ins=st.lists(signal, min_size=4, max_size=4),
+       sel=st.lists(st.integers(0, 3), min_size=N, max_size=N))
+def test_mux4_out_is_the_selected_input(hal, ins, sel):
+    once(hal, "mux4", "mux4.0")
+    s = np.array(sel)
+    inputs = {f"mux4.0.in{k}": np.array(ins[k]) for k in range(4)}
+    inputs.update({"mux4.0.sel0": (s & 1) == 1, "mux4.0.sel1": s >= 2})
+    out = hal.run(N, inputs=inputs, record=["mux4.0.out"])["mux4.0.out"]
+    assert (out == np.array(ins)[s, np.arange(N)]).all()
+
+
+@SETTINGS
+@given(sel=st.lists(st.integers(-3, 11), min_size=N, max_size=N),
+       enable=bits)
+def test_select8_one_hot(hal, sel, enable):
+    once(hal, "select8", "select8.0")
+    names = [f"select8.0.out{k}" for k in range(8)]
+    tr = hal.run(N, inputs={"select8.0.sel": np.array(sel),
+                            "select8.0.enable": np.array(enable)},
+                 record=names)
+    outs = np.array([tr[n] for n in names])
+    for k in range(N):
+        want = np.zeros(8, bool)
+        if enable[k] and 0 <= sel[k] < 8:
+            want[sel[k]] = True
+        assert (outs[:, k] == want).all()
+
+
+@SETTINGS
+@given(words=st.lists(st.integers(0, 2**32 - 1), min_size=N, max_size=N))
+def test_bitslice_reconstructs_the_input(hal, words):
+    once(hal, "bitslice", "bitslice.0", args=("personality=32",))
+    names = [f"bitslice.0.out-{k:02d}" for k in range(32)]
+    tr = hal.run(N, inputs={"bitslice.0.in": np.array(words, np.uint64)},
+                 record=names)
+    back = sum(tr[n].astype(np.uint64) << np.uint64(k)
+               for k, n in enumerate(names))
+    assert (back == np.array(words, np.uint64)).all()
+
+
+@SETTINGS
+@given(up=bits, down=bits, a=st.integers(-20, 20), b=st.integers(-20, 20),
+       clamp=st.booleans())
+def test_updown_counts_edges_within_limits(hal, up, down, a, b, clamp):
+    once(hal, "updown", "updown.0")
+    lo, hi = min(a, b), max(a, b)
+    hal.set({"updown.0.min": lo, "updown.0.max": hi,
+             "updown.0.clamp": clamp, "updown.0.wrap": False,
+             "updown.0.countup": False, "updown.0.countdown": False,
+             "updown.0.reset": True})
+    hal.step(1)
+    hal.setp("updown.0.reset", False)
+    count = hal.run(N, inputs={"updown.0.countup": np.array(up),
+                               "updown.0.countdown": np.array(down)},
+                    record=["updown.0.count"])["updown.0.count"]
+    u = np.diff(np.concatenate([[0], np.array(up, int)])) == 1
+    d = np.diff(np.concatenate([[0], np.array(down, int)])) == 1
+    if clamp:
+        assert count.min() >= lo and count.max() <= hi
+    else:
+        assert (count == np.cumsum(u.astype(int) - d)).all()
+
+
+@settings(max_examples=30, deadline=None,
+          suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(moves=st.lists(st.sampled_from([-1, 0, 1]), min_size=N, max_size=N),
+       x4=st.booleans())
+def test_encoder_counts_match_quadrature_edges(hal, moves, x4):
+    if not hal.components("encoder"):
+        hal.loadrt("encoder")
+        hal.newthread("t", 1_000_000)
+        hal.addf("encoder.update-counters", "t")
+        hal.addf("encoder.capture-position", "t")
+    hal.set({"encoder.0.x4-mode": x4, "encoder.0.phase-A": False,
+             "encoder.0.phase-B": False, "encoder.0.reset": True})
+    hal.step(2)
+    hal.setp("encoder.0.reset", False)
+    # Gray code states 00 10 11 01: +1 per step forward
+    gray = [(0, 0), (1, 0), (1, 1), (0, 1)]
+    state = np.cumsum(moves)
+    a = np.array([gray[s % 4][0] for s in state], bool)
+    b = np.array([gray[s % 4][1] for s in state], bool)
+    raw0 = hal.getp("encoder.0.rawcounts")
+    tr = hal.run(N, inputs={"encoder.0.phase-A": a, "encoder.0.phase-B": b},
+                 record=["encoder.0.rawcounts", "encoder.0.counts"])
+    raw = tr["encoder.0.rawcounts"] - raw0
+    if x4:
+        # one count per edge
+        assert (raw == state).all()
+    else:
+        # one count per full cycle of the phases, either way
+        assert (np.abs(raw - state / 4) <= 1).all()
