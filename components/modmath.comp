@@ -8,13 +8,16 @@ where it should go (\\fBdesired\\fR), both positions in the range
 \\fBmin-num\\fR ... \\fBmax-num\\fR, and tells which way to turn: \\fBup\\fR
 (towards higher numbers), \\fBdown\\fR, or \\fBon-target\\fR.
 
-The difference desired - actual is first reduced to the size of the range,
-M = max-num - min-num + 1, keeping its sign (C's remainder).  When
+Both positions are first reduced to the range, counted from min-num,
+M = max-num - min-num + 1, each keeping its sign (C's remainder of
+position - min-num by M), and the difference of the two is taken.  When
 \\fBwrap\\fR is TRUE, the range is a circle (position max-num is next to
-min-num) and a difference of more than half a turn is replaced by the
-shorter way the other way round; at exactly half a turn (even M) the
+min-num) and a difference of more than half a turn is replaced, once, by
+the way the other way round; at exactly half a turn (even M) the
 direction of the plain difference is kept.  With \\fBwrap\\fR FALSE the
-reduced difference is used as it is.
+difference is used as it is.  Positions outside the range thus give
+answers that are not always the shortest way (as in LinuxCNC); with
+M = 0 nothing is reduced.
 
 A carousel with pockets 1 to 8 uses min-num 1 and max-num 8: from 7 to 2
 the shortest way is up (7, 8, 1, 2).
@@ -46,18 +49,34 @@ option rtapi_app no;
 static int mod_dir = 0;
 RTAPI_MP_INT(mod_dir, "number of mod-dir instances to make");
 
-FUNCTION(_) {
-    rtapi_s32 m = max_num - min_num + 1;
-    rtapi_s32 d = desired - actual;
+/* 32-bit two's complement arithmetic, wrapping as the reference's does */
+static rtapi_s32 wsub(rtapi_s32 a, rtapi_s32 b)
+{
+    return (rtapi_s32)((rtapi_u32)a - (rtapi_u32)b);
+}
 
-    /* an empty range (max-num = min-num - 1) has no remainder: compare as is */
-    if (m != 0)
-        d %= m;
+/* C's remainder, without the traps of x % 0 and INT_MIN % -1 */
+static rtapi_s32 rem(rtapi_s32 x, rtapi_s32 m)
+{
+    if (m == 0 || m == -1)
+        return m == 0 ? x : 0;
+    return x % m;
+}
+
+FUNCTION(_) {
+    rtapi_s32 m = wsub(wsub(max_num, min_num), -1);
+    /* each position is reduced to the range on its own, counted from
+       min-num, and the difference of the two is then turned at most
+       once by a whole range (positions outside the range give the
+       reference's answers) */
+    rtapi_s32 d = wsub(rem(wsub(desired, min_num), m),
+                       rem(wsub(actual, min_num), m));
+
     if (wrap) {
         if (d > m / 2)
-            d -= m;
+            d = wsub(d, m);
         else if (d < -(m / 2))
-            d += m;
+            d = (rtapi_s32)((rtapi_u32)d + (rtapi_u32)m);
     }
     up = d > 0;
     down = d < 0;
