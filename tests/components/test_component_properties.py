@@ -246,3 +246,106 @@ def test_encoder_counts_match_quadrature_edges(hal, moves, x4):
     else:
         # one count per full cycle of the phases, either way
         assert (np.abs(raw - state / 4) <= 1).all()
+
+
+@SETTINGS
+@given(ins=st.lists(signal, min_size=8, max_size=8),
+       sel=st.lists(st.integers(0, 7), min_size=N, max_size=N))
+def test_mux8_out_is_the_selected_input(hal, ins, sel):
+    once(hal, "mux8", "mux8.0")
+    s = np.array(sel)
+    inputs = {f"mux8.0.in{k}": np.array(ins[k]) for k in range(8)}
+    inputs.update({f"mux8.0.sel{b}": (s >> b) & 1 == 1 for b in range(3)})
+    out = hal.run(N, inputs=inputs, record=["mux8.0.out"])["mux8.0.out"]
+    assert (out == np.array(ins)[s, np.arange(N)]).all()
+
+
+@SETTINGS
+@given(base=finite, step=finite,
+       sel=st.lists(st.integers(0, 15), min_size=N, max_size=N))
+def test_mux16_out_is_the_selected_input(hal, base, step, sel):
+    once(hal, "mux16", "mux16.0")
+    hal.set({"mux16.0.use-graycode": False, "mux16.0.debounce-time": 0.0})
+    # sixteen different inputs (hypothesis chokes on 16 lists of N)
+    ins = base + np.arange(16)[:, None] * 1000.0 + np.arange(N) * step
+    s = np.array(sel)
+    inputs = {f"mux16.0.in{k:02d}": ins[k] for k in range(16)}
+    inputs.update({f"mux16.0.sel{b}": (s >> b) & 1 == 1 for b in range(4)})
+    tr = hal.run(N, inputs=inputs, record=["mux16.0.out-f"])
+    assert (tr["mux16.0.out-f"] == ins[s, np.arange(N)]).all()
+
+
+@SETTINGS
+@given(a=bits, b=bits)
+def test_not_or2_xor2_truth_tables(hal, a, b):
+    if not hal.components("not"):
+        for comp in ("not", "or2", "xor2"):
+            hal.loadrt(comp)
+        hal.newthread("t", 1_000_000)
+        for f in ("not.0", "or2.0", "xor2.0"):
+            hal.addf(f, "t")
+    x, y = np.array(a), np.array(b)
+    tr = hal.run(N, inputs={"not.0.in": x, "or2.0.in0": x, "or2.0.in1": y,
+                            "xor2.0.in0": x, "xor2.0.in1": y},
+                 record=["not.0.out", "or2.0.out", "xor2.0.out"])
+    assert (tr["not.0.out"] == ~x).all()
+    assert (tr["or2.0.out"] == (x | y)).all()
+    assert (tr["xor2.0.out"] == (x ^ y)).all()
+
+
+@SETTINGS
+@given(ins=st.lists(bits, min_size=4, max_size=4),
+       weights=st.lists(st.integers(-2**20, 2**20), min_size=4, max_size=4),
+       offset=st.integers(-2**20, 2**20))
+def test_weighted_sum_is_offset_plus_true_weights(hal, ins, weights, offset):
+    once(hal, "weighted_sum", "process_wsums", args=("wsum_sizes=4",))
+    hal.set({f"wsum.0.bit.{k}.weight": weights[k] for k in range(4)})
+    hal.set({"wsum.0.offset": offset, "wsum.0.hold": False})
+    x = np.array(ins)
+    tr = hal.run(N, inputs={f"wsum.0.bit.{k}.in": x[k] for k in range(4)},
+                 record=["wsum.0.sum"])
+    assert (tr["wsum.0.sum"] == offset + np.array(weights) @ x).all()
+
+
+def _debounced(x, on, off):
+    """out follows x once x has differed from it for on (rising) or off
+    (falling) cycles in a row."""
+    out, run, res = False, 0, []
+    for v in x:
+        run = run + 1 if v != out else 0
+        if run and run >= (on if v else off):
+            out, run = bool(v), 0
+        res.append(out)
+    return np.array(res)
+
+
+@SETTINGS
+@given(x=bits, on=st.integers(1, 6), off=st.integers(1, 6))
+def test_timedelay_switches_after_whole_cycles(hal, x, on, off):
+    once(hal, "timedelay", "timedelay.0")
+    # half a period short: no rounding doubt about the cycle count
+    hal.set({"timedelay.0.on-delay": (on - 0.5) * 1e-3,
+             "timedelay.0.off-delay": (off - 0.5) * 1e-3,
+             "timedelay.0.in": False})
+    hal.step(max(on, off) + 2)      # back to out FALSE, timer 0
+    out = hal.run(N, inputs={"timedelay.0.in": np.array(x)},
+                  record=["timedelay.0.out"])["timedelay.0.out"]
+    assert (out == _debounced(x, on, off)).all()
+
+
+@SETTINGS
+@given(x=bits, w=st.integers(1, 8))
+def test_oneshot_pulse_is_width_cycles_after_each_edge(hal, x, w):
+    once(hal, "oneshot", "oneshot.0")
+    hal.set({"oneshot.0.width": (w - 0.5) * 1e-3, "oneshot.0.in": False,
+             "oneshot.0.reset": True})
+    hal.step(1)
+    hal.setp("oneshot.0.reset", False)
+    tr = hal.run(N, inputs={"oneshot.0.in": np.array(x)},
+                 record=["oneshot.0.out", "oneshot.0.out-not"])
+    xi = np.array(x, int)
+    edge = np.diff(np.concatenate([[0], xi])) == 1
+    # retriggerable: TRUE while an edge is less than w cycles old
+    want = np.array([edge[max(0, t - w + 1):t + 1].any() for t in range(N)])
+    assert (tr["oneshot.0.out"] == want).all()
+    assert (tr["oneshot.0.out-not"] == ~want).all()
