@@ -2,7 +2,7 @@ component updown "Up/down counter with optional limits or wrap-around";
 
 pin in bit countup "Each rising edge adds one to count";
 pin in bit countdown "Each rising edge takes one from count";
-pin in bit reset "A rising edge sets count to 0";
+pin in bit reset "While TRUE, count is held at 0 (edges of countup and countdown are still seen and lost)";
 pin out s32 count "The count";
 
 param rw bit clamp "When TRUE, count is held between min and max";
@@ -41,8 +41,8 @@ FUNCTION(_) {
         c++;
     if (countdown && !last_down)
         c--;
-    if (reset && !last_reset)
-        c = 0;
+    if (reset)
+        c = 0;          /* held at 0 while reset is TRUE, as the reference */
     last_up = countup;
     last_down = countdown;
     last_reset = reset;
