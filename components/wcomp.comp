@@ -3,7 +3,7 @@ component wcomp "Window comparator";
 pin in float in "The value to test";
 pin in float min "Lower edge of the window";
 pin in float max "Upper edge of the window";
-pin out bit out "TRUE when min < in < max";
+pin out bit out "TRUE when neither over nor under: min < in < max, or a NaN in in, min or max";
 pin out bit under "TRUE when in <= min";
 pin out bit over "TRUE when in >= max";
 
@@ -19,7 +19,8 @@ license "GPL";
 FUNCTION(_) {
     double v = in, lo = min, hi = max;
 
-    out = v > lo && v < hi;
     under = v <= lo;
     over = v >= hi;
+    /* neither over nor under: a NaN (in, min or max) counts as inside */
+    out = !(over || under);
 }
