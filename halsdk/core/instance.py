@@ -125,7 +125,7 @@ def _probe_settled(shm: str) -> tuple[Any, ...]:
 def _attach_or_create(shm: str, create: Optional[bool],
                       size: Optional[int]) -> Connection:
     label = instance_label(shm)
-    for _attempt in range(2):
+    for _attempt in range(3):
         state, pid, start, abi = _probe_settled(shm)
         if state == "junk":
             raise InstanceError(f"{SHM_DIR}{shm} is not a halsdk instance; "
@@ -171,9 +171,10 @@ def _attach_or_create(shm: str, create: Optional[bool],
 def _take_over(shm: str, label: str, pid: int) -> bool:
     """Remove the segment of an instance whose host is verifiably gone
     (its pid is not running, or runs another program since the host's
-    start time), with a one-line note on stderr.  False when the name
-    does not hold that dead instance any more (another process took it
-    over first, or it is not a plain file we can remove).
+    start time), with a one-line note on stderr.  True when the caller
+    may look again: the dead instance was removed here, or the name
+    holds another instance now (another process took it over first);
+    False when it cannot be removed (not a file this user may open).
 
     Two processes may take over at once: each locks the segment file it
     opened and removes the name only while the name still refers to that
@@ -201,7 +202,7 @@ def _take_over(shm: str, label: str, pid: int) -> bool:
         if same:
             state, now_pid, start, _abi = _core.probe(shm)
             if state != "ok" or _core.pid_alive(now_pid, start):
-                return False    # not the dead instance we saw: leave it
+                return True     # another process took it over: attach
             os.unlink(path)
             channel.remove_socket(shm)
             print(f"halsdk: HAL instance '{label}': its host (pid {pid}) "

@@ -759,6 +759,11 @@ def test_racing_takeovers_make_one_host(no_connection, spawn):
         assert dead_host.readline() == f"ready {dead_host.pid}"
         assert dead_host.kill() == -signal.SIGKILL
         racers = [spawn("take_over.py", name) for _ in range(4)]
+        for r in racers:
+            assert r.readline(30) == "loaded"
+        for r in racers:
+            r.proc.stdin.write("go\n")
+            r.proc.stdin.flush()
         replies = [json.loads(r.readline(30)) for r in racers]
         hosts = [r for r in replies if r["is_host"]]
         assert len(hosts) == 1, replies

@@ -2,7 +2,8 @@
 
 Usage: ``take_over.py INSTANCE``
 
-Opens INSTANCE with ``create=None`` (attach, or create it when no live
+Prints ``loaded``, waits for a line on stdin (so that several racers
+start together), opens INSTANCE with ``create=None`` (attach, or create it when no live
 host has it), prints one JSON line (``pid``, ``is_host``, ``host_pid``,
 ``inode`` of the segment it mapped), then waits until stdin is closed.
 """
@@ -15,6 +16,8 @@ import halsdk
 
 
 def main() -> int:
+    print("loaded", flush=True)
+    sys.stdin.readline()
     hal = halsdk.Hal(sys.argv[1], size=2 * 1024 * 1024)
     shm = halsdk.core.instance.shm_name(sys.argv[1])
     print(json.dumps({"pid": os.getpid(), "is_host": hal.is_host,
