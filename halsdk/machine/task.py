@@ -126,7 +126,14 @@ class Task:
             if self.state is TaskState.ON:
                 return None
             self.io.machine_on()
-            self.motion.enable()
+            try:
+                self.motion.enable()
+            except HalError as e:
+                # motmod refused, or a fault (amplifier, hard limit, ...)
+                # disabled motion at once: the machine stays off
+                self.io.machine_off()
+                raise MachineError("machine on failed: "
+                                   + getattr(e, "reason", str(e))) from e
             self._was_on = True
             self._apply_mode(self.mode)
         else:                                   # OFF

@@ -14,6 +14,7 @@ See docs/motion.rst for the commands and the status.
 """
 
 from halsdk.motion.client import (
+    EnableFailed,
     InputWait,
     Motion,
     MotionError,
@@ -49,8 +50,8 @@ from halsdk.motion.status import (
     Status,
 )
 
-__all__ = ["Motion", "Rejected", "QueueRejected", "MotionError",
-           "MotionTimeout", "Cmd", "Echo", "InputWait", "Status",
+__all__ = ["Motion", "Rejected", "EnableFailed", "QueueRejected",
+           "MotionError", "MotionTimeout", "Cmd", "Echo", "InputWait", "Status",
            "JointStatus", "AxisStatus", "SpindleStatus", "OrientState",
            "Mode", "KinsType", "MotionType", "Profile", "TermCond", "Pose",
            "HomeFlag", "JointFlag", "ProbeFlag", "HOME_SEQUENCE_NONE",

@@ -43,9 +43,20 @@ from halsdk.motion.protocol import (
     Profile,
     TermCond,
 )
-from halsdk.motion.status import AXES, JOINT_HOMED, Pose, Status
+from halsdk.motion.status import (
+    AXES,
+    JOINT_ERROR,
+    JOINT_FAULT,
+    JOINT_FERROR,
+    JOINT_HOMED,
+    JOINT_NEG_HARD,
+    JOINT_POS_HARD,
+    Pose,
+    Status,
+)
 
-__all__ = ["Motion", "Rejected", "QueueRejected", "MotionError",
+__all__ = ["Motion", "Rejected", "EnableFailed", "QueueRejected",
+           "MotionError",
            "MotionTimeout", "Cmd", "Echo", "InputWait", "homing_fields"]
 
 CHANNEL_NAME = "motmod.channel"
@@ -91,6 +102,68 @@ class QueueRejected(Rejected):
 
     def __str__(self) -> str:
         return self.args[0]
+
+
+class EnableFailed(Rejected):
+    """motmod took ENABLE but a fault disabled motion again at once
+    (:meth:`Motion.enable`); motion stays disabled.
+
+    :ivar reason: why, naming the joint (or spindle) and the fault, e.g.
+        ``"joint 0 amplifier fault (joint.0.amp-fault-in is true)"``.
+    :ivar joint: the joint at fault, or None (spindle, ``motion.enable``,
+        a misc error, or not known).
+    :ivar fault: ``"amp-fault"``, ``"pos-hard-limit"``,
+        ``"neg-hard-limit"``, ``"following-error"``, ``"spindle-amp-fault"``,
+        ``"motion-enable"``, ``"misc-error"`` or ``"unknown"``.
+    :ivar messages: motmod's messages posted meanwhile.
+    """
+
+    def __init__(self, status: dict, messages: Sequence[str] = ()):
+        self.messages = list(messages)
+        self.joint, self.fault, reason = _enable_fault(status, self.messages)
+        Rejected.__init__(self, "ENABLE", reason)
+
+
+_DISABLED = ": motion disabled"
+
+
+def _enable_fault(d: dict, messages: Sequence[str]
+                  ) -> tuple[Optional[int], str, str]:
+    """(joint, fault kind, reason) of a motion that did not stay enabled,
+    from the joint flags of the status (the pins) and motmod's message."""
+    said = [t[:-len(_DISABLED)] for t in messages if t.endswith(_DISABLED)]
+    joints = d["joints"][:max(0, min(d["num_joints"], len(d["joints"])))]
+    for i, j in enumerate(joints):
+        f = j["flags"]
+        if not f & JOINT_ERROR:
+            continue
+        if f & JOINT_FAULT:
+            return (i, "amp-fault", f"joint {i} amplifier fault "
+                    f"(joint.{i}.amp-fault-in is true)")
+        if f & JOINT_FERROR:
+            told = [t for t in said if t.startswith(f"joint {i} following")]
+            return (i, "following-error", told[-1] if told else
+                    f"joint {i} following error exceeds its limit "
+                    f"{j['ferror_limit']:g}")
+        if f & JOINT_POS_HARD:
+            return (i, "pos-hard-limit", f"joint {i} on its positive hard "
+                    f"limit (joint.{i}.pos-lim-sw-in is true)")
+        if f & JOINT_NEG_HARD:
+            return (i, "neg-hard-limit", f"joint {i} on its negative hard "
+                    f"limit (joint.{i}.neg-lim-sw-in is true)")
+    for n, sp in enumerate(d["spindles"][:d["num_spindles"]]):
+        if sp["amp_fault"]:
+            return (None, "spindle-amp-fault", f"spindle {n} amplifier "
+                    f"fault (spindle.{n}.amp-fault-in is true)")
+    for t in reversed(said):
+        if t.startswith("motion.enable"):
+            return None, "motion-enable", "motion.enable went false"
+        if t.startswith("motion.misc-error"):
+            return None, "misc-error", t
+    if said:
+        return None, "unknown", said[-1]
+    return None, "unknown", ("motion did not stay enabled (motmod gave no "
+                             "reason)")
 
 
 class InputWait(enum.IntEnum):
@@ -331,9 +404,38 @@ class Motion:
         (needs all at rest; non-trivial kinematics need homing)."""
         self.command(Cmd.COORD)
 
-    def enable(self) -> None:
-        """Enable motion (amplifiers on, planners follow commands)."""
-        self.command(Cmd.ENABLE)
+    def enable(self, timeout: Optional[float] = None) -> None:
+        """Enable motion (amplifiers on, planners follow commands) and
+        wait (at most ``timeout``, default the client's) until
+        motion-controller has run a cycle with motion enabled.
+
+        Raises :class:`Rejected` when motmod refuses the command (e.g.
+        ``motion.enable`` is false) and :class:`EnableFailed` (a
+        :class:`Rejected`) when motmod took it but a fault disabled
+        motion again at once: an amplifier fault (``joint.N.amp-fault-in``,
+        ``spindle.N.amp-fault-in``), a hard limit switch
+        (``joint.N.pos-lim-sw-in`` / ``neg-lim-sw-in``, unless limits are
+        overridden), a following error, ``motion.enable`` going false or a
+        ``motion.misc-error-NN``; its text names the joint and the fault.
+        motmod's message stays in :meth:`errors` as well."""
+        self._pull_messages()
+        seen = len(self._pending)
+        self.command(Cmd.ENABLE, timeout)
+        try:
+            beat = self._ch.status()["heartbeat"]
+        except _channel.ChannelError as e:
+            raise MotionError(str(e)) from None
+        # the first status written by motion-controller after motmod took
+        # the command (in either order of the two functions in the thread)
+        d = self._wait(lambda: (x := self._ch.status())["heartbeat"] > beat
+                       and x, timeout,
+                       "ENABLE: motion-controller running a cycle (is it in "
+                       "a running thread?)")
+        if d["enabled"]:
+            return
+        self._pull_messages()
+        raise EnableFailed(d, self._pending[max(0, min(seen,
+                                                       len(self._pending))):])
 
     def disable(self) -> None:
         """Disable motion: stop at once, amplifiers off."""

@@ -215,6 +215,24 @@ def test_errors_name_file_and_line(machine, tmp_path):
         m.wait_program(timeout=10)
 
 
+@pytest.mark.parametrize("pin,text", [
+    ("joint.1.amp-fault-in", "joint 1 amplifier fault"),
+    ("joint.2.neg-lim-sw-in", "joint 2 on its negative hard limit"),
+])
+def test_machine_on_with_a_fault_stays_off_and_says_why(hal, machine, pin,
+                                                        text):
+    m = machine
+    hal.setp(pin, True)
+    m.state(TaskState.ESTOP_RESET)
+    with pytest.raises(MachineError, match=f"machine on failed: {text}"):
+        m.state(TaskState.ON)
+    st = m.status()
+    assert st.task_state is TaskState.ESTOP_RESET and not st.enabled
+    hal.setp(pin, False)
+    m.state(TaskState.ON)
+    assert m.status().task_state is TaskState.ON and m.status().enabled
+
+
 def test_a_runaway_loop_is_reported_like_other_gcode_errors(machine,
                                                              tmp_path):
     from halsdk.ini import IniFile

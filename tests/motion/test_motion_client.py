@@ -17,11 +17,14 @@ import threading
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as hst
 
 from halsdk.core import _core
 from halsdk.errors import HalError
 from halsdk.motion import (
     HOME_SEQUENCE_NONE,
+    EnableFailed,
     HomeFlag,
     Mode,
     Motion,
@@ -232,6 +235,116 @@ def test_motion_enable_pin_false_disables_and_refuses_enable(hal, machine):
     hal.set({"motion.enable": True})
     m.enable()
     assert m.status().enabled
+
+
+# ------------------------------------------------------------ enable
+
+
+@pytest.mark.parametrize("pins,joint,fault,text", [
+    ({"joint.1.amp-fault-in": True}, 1, "amp-fault",
+     "joint 1 amplifier fault (joint.1.amp-fault-in is true)"),
+    ({"joint.2.pos-lim-sw-in": True}, 2, "pos-hard-limit",
+     "joint 2 on its positive hard limit (joint.2.pos-lim-sw-in is true)"),
+    ({"joint.0.neg-lim-sw-in": True}, 0, "neg-hard-limit",
+     "joint 0 on its negative hard limit (joint.0.neg-lim-sw-in is true)"),
+    ({"spindle.0.amp-fault-in": True}, None, "spindle-amp-fault",
+     "spindle 0 amplifier fault (spindle.0.amp-fault-in is true)"),
+])
+def test_enable_with_a_fault_raises_the_reason(hal, machine, pins, joint,
+                                               fault, text):
+    m = machine
+    hal.set(pins)
+    with pytest.raises(EnableFailed) as e:
+        m.enable()
+    assert isinstance(e.value, Rejected) and e.value.command == "ENABLE"
+    assert str(e.value) == f"ENABLE rejected: {text}"
+    assert (e.value.joint, e.value.fault) == (joint, fault)
+    assert e.value.messages and "motion disabled" in e.value.messages[-1]
+    st = m.status()
+    assert not st.enabled and st.error
+    # the message stays for errors() (the task's error channel)
+    assert any("motion disabled" in t for t in m.errors())
+    hal.set({k: False for k in pins})
+    m.enable()
+    assert m.status().enabled
+
+
+def test_enable_with_limits_overridden_stays_enabled(hal, machine):
+    m = machine
+    hal.set({"joint.1.pos-lim-sw-in": True})
+    m.override_limits(True)
+    m.enable()
+    assert m.status().enabled
+    m.jog_incr(1, 5, -0.5)              # off the switch
+    hal.run(50)
+    hal.set({"joint.1.pos-lim-sw-in": False})
+    m.wait_inpos()
+    assert m.status().enabled
+
+
+def test_enable_when_the_fault_comes_in_the_same_cycle(hal, machine):
+    """A fault that motmod sees only in the controller cycle after the
+    command (motion-controller before the command handler in the thread)
+    is still caught."""
+    hal.delf("motion-controller", "servo-thread")
+    hal.addf("motion-controller", "servo-thread", position=1)
+    m = machine
+    hal.set({"joint.0.amp-fault-in": True})
+    with pytest.raises(EnableFailed, match="joint 0 amplifier fault"):
+        m.enable()
+
+
+def test_enable_with_a_fault_and_threads_running(hal, machine):
+    """Not stepped: enable() polls the status and still sees the drop."""
+    m = machine
+    hal.set({"joint.2.amp-fault-in": True})
+    hal.start()
+    try:
+        with pytest.raises(EnableFailed, match="joint 2 amplifier fault"):
+            m.enable(timeout=5)
+        hal.set({"joint.2.amp-fault-in": False})
+        m.enable(timeout=5)
+        assert m.status().enabled
+    finally:
+        hal.stop()
+
+
+def test_enable_without_the_controller_times_out_clearly(hal, machine):
+    hal.delf("motion-controller", "servo-thread")
+    with pytest.raises(MotionTimeout, match="motion-controller"):
+        machine.enable(timeout=0.01)
+
+
+FAULT_PINS = ("amp-fault-in", "pos-lim-sw-in", "neg-lim-sw-in")
+
+
+@settings(max_examples=25, deadline=None,
+          suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(faults=hst.sets(hst.tuples(hst.integers(0, 2), hst.sampled_from(
+    FAULT_PINS)), max_size=4))
+def test_enable_succeeds_exactly_when_no_fault_and_names_one(hal, machine,
+                                                             faults):
+    """enable() returns iff no joint has a fault; when it raises, the joint
+    and fault it names are one that is there."""
+    m = machine
+    m.disable()
+    pins = {f"joint.{j}.{p}": False for j in range(3) for p in FAULT_PINS}
+    pins.update({f"joint.{j}.{p}": True for j, p in faults})
+    hal.set(pins)
+    kind = {"amp-fault-in": "amp-fault", "pos-lim-sw-in": "pos-hard-limit",
+            "neg-lim-sw-in": "neg-hard-limit"}
+    if not faults:
+        m.enable()
+        assert m.status().enabled
+        return
+    with pytest.raises(EnableFailed) as e:
+        m.enable()
+    assert not m.status().enabled
+    named = (e.value.joint, e.value.fault)
+    present = {(j, kind[p]) for j, p in faults}
+    assert named in present, (named, present)
+    assert f"joint {e.value.joint} " in e.value.reason
+    m.errors()
 
 
 def test_wait_timeout_is_clear(machine):

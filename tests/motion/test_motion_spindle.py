@@ -12,6 +12,7 @@ import pytest
 from helpers.motion_trace import looped_machine
 
 from halsdk.motion import (
+    EnableFailed,
     MotionError,
     OrientState,
     Rejected,
@@ -186,8 +187,10 @@ def test_amp_fault_disables_with_a_message(hal, m):
     assert any("spindle 0 amplifier fault" in e for e in m.errors())
     with pytest.raises(Rejected, match="needs motion enabled"):
         m.spindle_on(600)
-    # enabling again with the fault still there: disabled at once
-    m.enable()
+    # enabling again with the fault still there: disabled at once, and
+    # enable() says so
+    with pytest.raises(EnableFailed, match="spindle 0 amplifier fault"):
+        m.enable()
     assert not m.status().enabled
     assert any("spindle 0 amplifier fault" in e for e in m.errors())
     hal.setp("spindle.0.amp-fault-in", False)
