@@ -85,6 +85,20 @@ static int cmd_jog_joint(mot_t *mot, const mot_command_t *c)
         }
         dir = t > j->pos_cmd ? 1 : (t < j->pos_cmd ? -1 : 0);
     }
+    if (homed && c->cmd == MOT_CMD_JOG_ABS) {
+        /* an absolute jog names a position: one beyond a soft limit is
+           refused, not cut short at the limit without a word (an
+           increment or a continuous jog still ends at the limit, as the
+           reference's "terminated at the soft limit") */
+        if (t > j->max_pos_limit)
+            return mot_reject(mot, "%s: joint %d target %g is beyond its "
+                              "positive soft limit (%g)", name, n, t,
+                              j->max_pos_limit);
+        if (t < j->min_pos_limit)
+            return mot_reject(mot, "%s: joint %d target %g is beyond its "
+                              "negative soft limit (%g)", name, n, t,
+                              j->min_pos_limit);
+    }
     if (homed) {
         if (dir > 0 && j->pos_cmd >= j->max_pos_limit)
             return mot_reject(mot, "%s: joint %d is at its positive soft "
@@ -182,6 +196,17 @@ static int cmd_jog_axis(mot_t *mot, const mot_command_t *c)
             t = c->offset;
         }
         dir = t > pos ? 1 : (t < pos ? -1 : 0);
+    }
+    if (mot_all_homed(mot) && c->cmd == MOT_CMD_JOG_ABS) {
+        /* as for a joint: an absolute target beyond a limit is refused */
+        if (t > a->max_pos_limit)
+            return mot_reject(mot, "%s: axis %c target %g is beyond its "
+                              "positive limit (%g)", name,
+                              mot_axis_letters[n], t, a->max_pos_limit);
+        if (t < a->min_pos_limit)
+            return mot_reject(mot, "%s: axis %c target %g is beyond its "
+                              "negative limit (%g)", name,
+                              mot_axis_letters[n], t, a->min_pos_limit);
     }
     t = axis_clamp(mot, n, t, &lim);
     if (mot_all_homed(mot)) {

@@ -315,6 +315,88 @@ def test_enable_without_the_controller_times_out_clearly(hal, machine):
         machine.enable(timeout=0.01)
 
 
+# ------------------------------------------------------------ jogs and limits
+
+
+def _homed_machine(m):
+    """Every joint homed where it stands (0), soft limits -2 .. 3."""
+    for j in range(3):
+        m.set_joint_homing(j, HOME=0, HOME_OFFSET=0, HOME_SEARCH_VEL=0,
+                           HOME_SEQUENCE=0)
+        m.set_joint_limits(j, -2.0, 3.0)
+    for a in "xyz":
+        m.set_axis_limits(a, -2.0, 3.0)
+    m.enable()
+    m.home(-1)
+    m.wait_homed(timeout=2)
+    m.wait_inpos()
+    return m
+
+
+def test_jog_abs_beyond_a_soft_limit_is_refused_and_nothing_moves(machine):
+    m = _homed_machine(machine)
+    with pytest.raises(Rejected, match=r"JOG_ABS: joint 0 target 7 is beyond "
+                       r"its positive soft limit \(3\)"):
+        m.jog_abs(0, 10, 7.0)
+    with pytest.raises(Rejected, match=r"joint 1 target -2\.5 is beyond its "
+                       r"negative soft limit \(-2\)"):
+        m.jog_abs(1, 10, -2.5)
+    st = m.status()
+    assert st.in_position and not st.joints[0].jog_active
+    assert [j.pos_cmd for j in st.joints] == [0.0, 0.0, 0.0]
+    m.jog_abs(0, 10, 3.0)               # exactly on the limit: fine
+    assert m.wait_inpos().joints[0].pos_cmd == 3.0
+    # an increment past the limit still ends at it (the reference's
+    # "terminated at the soft limit")
+    m.jog_abs(0, 10, 2.5)
+    m.wait_inpos()
+    m.jog_incr(0, 10, 2.0)
+    assert m.wait_inpos().joints[0].pos_cmd == 3.0
+    # teleop: an axis target beyond its limit is refused the same way
+    m.jog_abs(0, 10, 0.0)
+    m.wait_inpos()
+    m.teleop()
+    with pytest.raises(Rejected, match=r"JOG_ABS: axis X target 4 is beyond "
+                       r"its positive limit \(3\)"):
+        m.jog_abs("x", 10, 4.0, teleop=True)
+    assert m.status().axes[0].teleop_target == pytest.approx(0.0)
+    m.jog_abs("x", 10, -1.0, teleop=True)
+    assert m.wait_inpos().carte_pos_cmd.x == pytest.approx(-1.0, abs=1e-9)
+
+
+def test_jog_abs_unhomed_ignores_the_soft_limits(machine):
+    m = machine
+    m.set_joint_limits(0, -2.0, 3.0)
+    m.enable()
+    m.jog_abs(0, 20, 4.0)               # soft limits need homing
+    assert m.wait_inpos().joints[0].pos_cmd == pytest.approx(4.0)
+
+
+@settings(max_examples=30, deadline=None,
+          suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(joint=hst.integers(0, 2),
+       target=hst.floats(-6.0, 6.0, allow_nan=False))
+def test_jog_abs_is_accepted_exactly_within_the_soft_limits(machine, joint,
+                                                            target):
+    """Homed: a JOG_ABS is accepted iff its target lies within the soft
+    limits, and then aims at the target itself (never a clamped one)."""
+    m = machine
+    if not m.status().all_homed:
+        _homed_machine(m)
+    inside = -2.0 <= target <= 3.0
+    try:
+        m.jog_abs(joint, 20, target)
+    except Rejected as e:
+        assert not inside, e
+        assert "soft limit" in e.reason and f"joint {joint} " in e.reason
+        assert not m.status().joints[joint].jog_active
+        return
+    assert inside
+    assert m.status().joints[joint].free_target == target
+    m.abort()
+    m.wait_inpos()
+
+
 FAULT_PINS = ("amp-fault-in", "pos-lim-sw-in", "neg-lim-sw-in")
 
 

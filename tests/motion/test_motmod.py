@@ -355,7 +355,10 @@ def test_jog_abs_and_cont_respect_soft_limits_when_homed(m):
     assert "joint 0 is at its positive soft limit (0.5)" in why
     assert "positive soft limit" in m.no(Cmd.JOG_ABS, joint=0, vel=1.0,
                                          offset=9.0)
-    m.ok(Cmd.JOG_ABS, joint=0, vel=10.0, offset=-9.0)    # clamped to -1
+    # an absolute target beyond the soft limit is refused, not clamped
+    why = m.no(Cmd.JOG_ABS, joint=0, vel=10.0, offset=-9.0)
+    assert "joint 0 target -9 is beyond its negative soft limit (-1)" in why
+    m.ok(Cmd.JOG_ABS, joint=0, vel=10.0, offset=-1.0)
     m.wait_still()
     assert m.hal.getp("joint.0.pos-cmd") == -1.0
 
