@@ -259,8 +259,11 @@ def test_modmath_without_mod_dir_makes_nothing(hal):
 
 
 def _direction(actual, desired, lo, hi, wrap):
+    # the reference's rule: each position reduced to the range on its own
+    # (C's remainder, counted from min-num), the difference then turned
+    # at most once by a whole range
     m = hi - lo + 1
-    d = int(math.fmod(desired - actual, m))
+    d = int(math.fmod(desired - lo, m)) - int(math.fmod(actual - lo, m))
     if wrap and d > m // 2:
         d -= m
     elif wrap and d < -(m // 2):
