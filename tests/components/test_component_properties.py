@@ -390,3 +390,24 @@ def test_ton_never_reaches_a_nan_or_infinite_pt(hal, x, pt):
     for k, v in enumerate(x):
         run = run + 1 if v else 0
         assert abs(tr["ton.0.et"][k] - run * 1e-3) < 1e-9
+
+
+@SETTINGS
+@given(en=bits, x=bits, k=st.integers(1, 4))
+def test_watchdog_ok_only_while_enabled_and_in_time(hal, en, x, k):
+    if not hal.components("watchdog"):
+        setup(hal, "watchdog", "watchdog.process", "watchdog.set-timeouts",
+              args=("num_inputs=1",))
+    hal.set({"watchdog.timeout-0": (k - 0.5) * 1e-3,
+             "watchdog.enable-in": False})
+    hal.step(1)
+    tr = hal.run(N, inputs={"watchdog.enable-in": np.array(en),
+                            "watchdog.input-0": np.array(x)},
+                 record=["watchdog.ok-out"])
+    ok = tr["watchdog.ok-out"]
+    for t in range(N):
+        if not en[t]:
+            assert not ok[t]
+        elif ok[t] and not (t == 0 or not en[t - 1]):
+            # ok-out turns TRUE only at a rising edge of enable-in
+            assert ok[t - 1]
