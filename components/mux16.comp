@@ -4,9 +4,11 @@ description """The four sel bits form a number (sel3 the most significant bit, o
 Gray code when use-graycode is TRUE) that chooses which of in00 to in15 is
 copied to out-f and, truncated towards zero, to out-s.
 
-A non-zero debounce-time makes a new selection wait until it has differed
-from the current one for that long, so that a rotary switch passing through
-other positions does not make the output jump. suppress-no-input keeps the
+A non-zero debounce-time makes a new selection wait until the sel bits have
+differed from the current one for that long, so that a rotary switch
+passing through other positions does not make the output jump. The time
+counts the cycles in which they differed since the last switch, also when
+they went back to the current selection in between (as LinuxCNC 2.9). suppress-no-input keeps the
 output unchanged while all four sel bits are FALSE, for switches that open
 every contact between two positions (in00 can then not be chosen).""";
 
@@ -42,11 +44,10 @@ FUNCTION(_) {
         n ^= n >> 1;
     }
 
-    if (n == selected) {
-        pending = 0;
-    } else {
-        /* a new selection: time it from its first cycle, even if it
-           keeps changing while the time runs */
+    if (n != selected) {
+        /* a new selection: time it from its first cycle after the last
+           switch, even if it keeps changing (or goes back to the selected
+           input for a while) while the time runs, as the reference */
         if (!pending) {
             pending = 1;
             elapsed = 0;

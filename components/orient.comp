@@ -6,22 +6,23 @@ stop the spindle at a given angle (M19).
 
 When \\fBenable\\fR goes TRUE, the current \\fBposition\\fR (in revolutions,
 from the spindle encoder) is sampled once and \\fBcommand\\fR is set to the
-target angle in the revolution the spindle is in,
-floor(position) + angle/360, moved by one revolution where the
-\\fBmode\\fR asks for it:
+target angle, angle/360, plus the whole number of revolutions that
+puts it where the \\fBmode\\fR asks for, as seen from the position
+(for an angle so large that whole revolutions are lost in the
+rounding of the sum, the command is what that rounding gives, as in
+LinuxCNC 2.9):
 .TP
 \\fB0\\fR
-the nearer of the two ways round: the target is moved a revolution
-when it lies more than half a revolution ahead (or half a revolution or
-more behind);
+the nearer of the two ways round: the target is at most half a
+revolution from the position (exactly half a revolution: ahead);
 .TP
 \\fB1\\fR
-always forward (increasing position, clockwise): a
-target behind the spindle is moved a revolution ahead;
+always forward (increasing position, clockwise): the target is at the
+position or less than a revolution ahead of it;
 .TP
 \\fB2\\fR
-always backward: a target ahead of the spindle is moved a revolution
-behind.
+always backward: the target is at the position or less than a
+revolution behind it.
 .PP
 With any other mode the command keeps its previous value. The command
 then holds until the next rising edge of enable.
@@ -68,26 +69,22 @@ license "GPL";
 
 FUNCTION(_) {
     if (enable && !last_enable) {
-        double base = floor(position) + angle / 360.0;
-        double ahead = base - position;  /* revolutions to the target */
+        /* the target angle in revolutions plus a whole number of
+           revolutions, chosen from the revolutions between the target and
+           the position: for a huge angle the whole revolutions are lost
+           in the rounding of the sum, as in the reference */
+        double target = angle / 360.0;
+        double behind = position - target;
 
         switch (mode) {
         case 0:
-            if (ahead > 0.5)
-                base -= 1.0;
-            else if (ahead <= -0.5)
-                base += 1.0;
-            command = base;
+            command = target + floor(behind + 0.5);
             break;
         case 1:
-            if (base < position)
-                base += 1.0;
-            command = base;
+            command = target + ceil(behind);
             break;
         case 2:
-            if (base > position)
-                base -= 1.0;
-            command = base;
+            command = target + floor(behind);
             break;
         default:
             break;  /* unknown mode: keep the command */

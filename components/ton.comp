@@ -24,9 +24,10 @@ FUNCTION(_) {
     if (!in) {
         q = 0;
         et = 0;
-    } else if (et < pt) {
-        et += fperiod;
-    } else {
+    } else if (et >= pt) {
         q = 1;
+    } else {
+        /* a NaN pt is never reached: et counts on and q stays FALSE */
+        et += fperiod;
     }
 }

@@ -27,7 +27,7 @@ pin in bit input_n "Heartbeat input \\fIn\\fR (0 to num_inputs\\-1): it must cha
 pin in bit enable_in = false "Turn the watchdog on: ok-out can only be TRUE while this is TRUE, and a rising edge restarts the monitoring after a timeout";
 pin out bit ok_out = false "TRUE while enabled and no input has timed out; connect it, for example, to a charge pump or a stepgen enable";
 
-param rw float timeout_n "Longest time in seconds that input \\fIn\\fR may stay unchanged; a negative value acts as 0 (an input then times out in each cycle in which it does not change), and a very long one makes the watchdog useless";
+param rw float timeout_n "Longest time in seconds that input \\fIn\\fR may stay unchanged; a value of 0 or less makes an input time out in each cycle in which it does not change; one that is not a number, or too large for a count of nanoseconds (about 9.2e9 s either way), never times out, as in the reference";
 
 function process nofp "Look for changes of the inputs and clear ok-out when one times out";
 function set_timeouts "Take the timeouts and enable-in into account";
@@ -37,6 +37,15 @@ modparam int num_inputs = 0 "Number of inputs, 1 to 32; required";
 option singleton yes;
 option rtapi_app no;
 
+notes """While \\fBenable-in\\fR is FALSE (and after a timeout, until
+its next rising edge), the inputs are not watched and their values are
+not taken: at the rising edge, an input that differs from the value seen
+last counts as a change.
+
+LinuxCNC 2.9's watchdog leaves \\fBok-out\\fR TRUE when \\fBenable-in\\fR
+goes FALSE (until the next timeout after a new rising edge), against its
+own manual page; this one makes \\fBok-out\\fR FALSE while
+\\fBenable-in\\fR is FALSE, as documented.""";
 see_also "charge_pump(9)";
 license "GPL";
 author "the halsdk authors";
@@ -57,12 +66,19 @@ static struct wd_state {
     hal_bit_t *enable;          /* enable-in */
     hal_bit_t *ok;              /* ok-out */
     int was_enabled;
+    int watching;               /* from a rising edge of enable-in to a timeout */
     struct wd_input inputs[MAX_INPUTS];
 } *wd;
 
 FUNCTION(process) {
     int n;
 
+    /* as the reference, nothing is watched (nor are the inputs' values
+       taken) while enable-in is FALSE or after a timeout, until the next
+       rising edge of enable-in: an input that differs then from the value
+       seen last counts as a change */
+    if (!*wd->enable || !wd->watching)
+        return;
     for (n = 0; n < num_inputs; n++) {
         struct wd_input *p = &wd->inputs[n];
         int in = *p->in;
@@ -71,11 +87,29 @@ FUNCTION(process) {
             p->last = in;
             p->left_ns = p->limit_ns;
         } else {
-            p->left_ns -= period;
-            if (p->left_ns < 0)
+            /* wraps as the reference's count does: the count of a timeout
+               that is not a number or is out of range starts at the most
+               negative value and wraps to a positive one, so that such an
+               input never times out */
+            p->left_ns = (rtapi_s64)((rtapi_u64)p->left_ns
+                                     - (rtapi_u64)period);
+            if (p->left_ns < 0) {
                 *wd->ok = 0;
+                wd->watching = 0;
+            }
         }
     }
+}
+
+/* a timeout in ns as the reference converts it: a value out of the
+   s64 range, or not a number, gives the most negative s64 */
+static rtapi_s64 timeout_ns(double t)
+{
+    double ns = t * 1e9;
+
+    if (ns > -9223372036854775808.0 && ns < 9223372036854775808.0)
+        return (rtapi_s64)ns;
+    return (rtapi_s64)((rtapi_u64)1 << 63);
 }
 
 FUNCTION(set_timeouts) {
@@ -84,15 +118,17 @@ FUNCTION(set_timeouts) {
     for (n = 0; n < num_inputs; n++) {
         struct wd_input *p = &wd->inputs[n];
 
-        p->limit_ns = p->timeout > 0 ? (rtapi_s64)(p->timeout * 1e9) : 0;
+        p->limit_ns = timeout_ns(p->timeout);
     }
     if (!*wd->enable) {
+        /* the reference leaves ok-out TRUE here (see the notes) */
         *wd->ok = 0;
     } else if (!wd->was_enabled) {
         /* switched on: start all timeouts afresh */
         for (n = 0; n < num_inputs; n++)
             wd->inputs[n].left_ns = wd->inputs[n].limit_ns;
         *wd->ok = 1;
+        wd->watching = 1;
     }
     wd->was_enabled = *wd->enable;
 }

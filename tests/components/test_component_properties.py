@@ -349,3 +349,65 @@ def test_oneshot_pulse_is_width_cycles_after_each_edge(hal, x, w):
     want = np.array([edge[max(0, t - w + 1):t + 1].any() for t in range(N)])
     assert (tr["oneshot.0.out"] == want).all()
     assert (tr["oneshot.0.out-not"] == ~want).all()
+
+
+@SETTINGS
+@given(angle=st.floats(-1e4, 1e4), position=st.floats(-1e4, 1e4),
+       mode=st.integers(0, 2))
+def test_orient_command_is_the_angle_on_the_side_the_mode_asks(
+        hal, angle, position, mode):
+    once(hal, "orient", "orient.0")
+    hal.set({"orient.0.enable": False, "orient.0.angle": angle,
+             "orient.0.position": position, "orient.0.mode": mode})
+    hal.step(1)
+    hal.setp("orient.0.enable", True)
+    hal.step(1)
+    command = hal.getp("orient.0.command")
+    ahead = command - position
+    # the target angle plus whole revolutions
+    revs = command - angle / 360.0
+    assert abs(revs - round(revs)) < 1e-9
+    eps = 1e-9
+    if mode == 0:
+        assert -0.5 - eps < ahead <= 0.5 + eps
+    elif mode == 1:
+        assert -eps <= ahead < 1 + eps
+    else:
+        assert -1 - eps < ahead <= eps
+
+
+@SETTINGS
+@given(x=bits, pt=st.sampled_from([float("nan"), float("inf")]))
+def test_ton_never_reaches_a_nan_or_infinite_pt(hal, x, pt):
+    once(hal, "ton", "ton.0")
+    hal.set({"ton.0.pt": pt, "ton.0.in": False})
+    hal.step(1)                     # et back to 0
+    tr = hal.run(N, inputs={"ton.0.in": np.array(x)},
+                 record=["ton.0.q", "ton.0.et"])
+    assert not tr["ton.0.q"].any()
+    # et counts the periods since in went TRUE
+    run = 0
+    for k, v in enumerate(x):
+        run = run + 1 if v else 0
+        assert abs(tr["ton.0.et"][k] - run * 1e-3) < 1e-9
+
+
+@SETTINGS
+@given(en=bits, x=bits, k=st.integers(1, 4))
+def test_watchdog_ok_only_while_enabled_and_in_time(hal, en, x, k):
+    if not hal.components("watchdog"):
+        setup(hal, "watchdog", "watchdog.process", "watchdog.set-timeouts",
+              args=("num_inputs=1",))
+    hal.set({"watchdog.timeout-0": (k - 0.5) * 1e-3,
+             "watchdog.enable-in": False})
+    hal.step(1)
+    tr = hal.run(N, inputs={"watchdog.enable-in": np.array(en),
+                            "watchdog.input-0": np.array(x)},
+                 record=["watchdog.ok-out"])
+    ok = tr["watchdog.ok-out"]
+    for t in range(N):
+        if not en[t]:
+            assert not ok[t]
+        elif ok[t] and not (t == 0 or not en[t - 1]):
+            # ok-out turns TRUE only at a rising edge of enable-in
+            assert ok[t - 1]
