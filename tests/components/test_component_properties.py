@@ -349,3 +349,30 @@ def test_oneshot_pulse_is_width_cycles_after_each_edge(hal, x, w):
     want = np.array([edge[max(0, t - w + 1):t + 1].any() for t in range(N)])
     assert (tr["oneshot.0.out"] == want).all()
     assert (tr["oneshot.0.out-not"] == ~want).all()
+
+
+@SETTINGS
+@given(amp=finite, off=finite, freq=st.floats(0.0, 499.0))
+def test_siggen_waves_share_one_phase(hal, amp, off, freq):
+    # (a negative frequency runs the phase below 0 without end, as in the
+    # reference: the waves then leave their range)
+    once(hal, "siggen", "siggen.0.update")
+    hal.set({"siggen.0.amplitude": amp, "siggen.0.offset": off,
+             "siggen.0.frequency": freq, "siggen.0.reset": True})
+    hal.step(1)
+    hal.setp("siggen.0.reset", False)
+    tr = hal.run(N, record=["siggen.0.sawtooth", "siggen.0.triangle",
+                            "siggen.0.square", "siggen.0.clock"])
+    # the sawtooth gives the phase; the triangle folds it, the square and
+    # the clock split it at one half
+    s = (tr["siggen.0.sawtooth"] - off) / amp if amp else None
+    tol = 1e-6 * (abs(amp) + abs(off)) + 1e-9
+    if s is not None:
+        assert (np.abs(s) <= 1 + 1e-6).all()
+        tri = amp * (2 * np.abs(s) - 1) + off
+        assert np.allclose(tr["siggen.0.triangle"], tri, rtol=0, atol=tol)
+        high = s > 0
+        sure = np.abs(s) > 1e-6
+        assert (tr["siggen.0.clock"][sure] == high[sure]).all()
+    sq = np.where(tr["siggen.0.clock"], amp + off, off - amp)
+    assert np.allclose(tr["siggen.0.square"], sq, rtol=0, atol=tol)
