@@ -376,3 +376,73 @@ def test_siggen_waves_share_one_phase(hal, amp, off, freq):
         assert (tr["siggen.0.clock"][sure] == high[sure]).all()
     sq = np.where(tr["siggen.0.clock"], amp + off, off - amp)
     assert np.allclose(tr["siggen.0.square"], sq, rtol=0, atol=tol)
+
+
+def _steps_made(tr, step_type):
+    """The signed number of steps in the recorded outputs of stepgen.0."""
+    def rises(x):
+        x = np.asarray(x, int)
+        return np.diff(np.concatenate([[0], x])) == 1
+    if step_type == 0:
+        up = rises(tr["stepgen.0.step"])
+        back = np.asarray(tr["stepgen.0.dir"], bool)
+        return int(up[~back].sum()) - int(up[back].sum())
+    if step_type == 1:
+        return int(rises(tr["stepgen.0.up"]).sum()
+                   - rises(tr["stepgen.0.down"]).sum())
+    # quadrature: the Gray code A/B moves one state a step
+    a = np.asarray(tr["stepgen.0.phase-A"], int)
+    b = np.asarray(tr["stepgen.0.phase-B"], int)
+    state = np.array([0, 1, 3, 2])[a * 2 + b]
+    d = np.diff(np.concatenate([[state[0]], state])) % 4
+    assert not (d == 2).any()
+    return int((d == 3).sum()) - int((d == 1).sum())
+
+
+@settings(max_examples=8, deadline=None,
+          suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(step_type=st.sampled_from([0, 1, 2]),
+       scale=st.floats(10.0, 500.0),
+       vel=st.floats(1000.0, 4000.0), acc=st.floats(5e4, 2e5),
+       targets=st.lists(st.integers(-60, 60), min_size=1, max_size=2),
+       frac=st.floats(-0.4, 0.4))
+def test_stepgen_steps_match_position_times_scale(hal, step_type, scale, vel,
+                                                  acc, targets, frac):
+    """Position mode: once the command has been still long enough to be
+    reached within maxvel and maxaccel, the steps made (counted on the
+    step outputs) are position-cmd * position-scale within one step."""
+    base, servo = 50_000, 1_000_000
+    hal.loadrt("stepgen", f"step_type={step_type}")
+    try:
+        hal.newthread("base", base, fp=False)
+        hal.newthread("servo", servo)
+        _stepgen_moves(hal, step_type, scale, vel, acc, targets, frac, base)
+    finally:
+        hal.unloadrt("stepgen")
+        for t in ("base", "servo"):
+            if hal.threads(t):
+                hal.delthread(t)
+
+
+def _stepgen_moves(hal, step_type, scale, vel, acc, targets, frac, base):
+    hal.addf("stepgen.make-pulses", "base")
+    hal.addf("stepgen.update-freq", "servo")
+    hal.addf("stepgen.capture-position", "servo")
+    # vel and acc in steps/s and steps/s^2, the limits in machine units
+    hal.set({"stepgen.0.position-scale": scale,
+             "stepgen.0.maxvel": vel / scale,
+             "stepgen.0.maxaccel": acc / scale,
+             "stepgen.0.enable": True})
+    here = 0.0
+    for t in targets:
+        goal = t + frac
+        d = abs(goal - here)
+        settle = vel / acc + d / vel + 2 * (d / acc) ** 0.5 + 0.01
+        n = int(settle * 1e9 / base) + 1
+        hal.setp("stepgen.0.position-cmd", goal / scale)
+        rec = {0: ["stepgen.0.step", "stepgen.0.dir"],
+               1: ["stepgen.0.up", "stepgen.0.down"],
+               2: ["stepgen.0.phase-A", "stepgen.0.phase-B"]}[step_type]
+        tr = hal.run(n, record=rec)
+        here += _steps_made(tr, step_type)
+        assert abs(here - goal) <= 1.0, (here, goal)
