@@ -328,9 +328,16 @@ FUNCTION(do_pid_calcs)
         ei = 0;
         err_d = 0;
         prev_cmd = 0;
+        /* the command derivatives start from 0 again too */
+        cmd_d = 0;
+        cmd_dd = 0;
+        cmd_ddd = 0;
         if (debug) {
             errorI = 0;
             errorD = 0;
+            commandD = 0;
+            commandDD = 0;
+            commandDDD = 0;
         }
         tstate = T_IDLE;
         return;
