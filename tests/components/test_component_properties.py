@@ -446,3 +446,23 @@ def _stepgen_moves(hal, step_type, scale, vel, acc, targets, frac, base):
         tr = hal.run(n, record=rec)
         here += _steps_made(tr, step_type)
         assert abs(here - goal) <= 1.0, (here, goal)
+
+
+@SETTINGS
+@given(cmd=signal, fb=signal, en=bits, maxout=finite,
+       gains=st.lists(st.floats(-100, 100), min_size=3, max_size=3))
+def test_pid_output_within_maxoutput_and_zero_when_disabled(
+        hal, cmd, fb, en, maxout, gains):
+    once(hal, "pid", "pid.0.do-pid-calcs", args=("num_chan=1",))
+    hal.set({"pid.0.Pgain": gains[0], "pid.0.Igain": gains[1],
+             "pid.0.FF1": gains[2], "pid.0.maxoutput": maxout})
+    tr = hal.run(N, inputs={"pid.0.command": np.array(cmd),
+                            "pid.0.feedback": np.array(fb),
+                            "pid.0.enable": np.array(en)},
+                 record=["pid.0.output", "pid.0.saturated"])
+    on = np.array(en)
+    out = tr["pid.0.output"]
+    # disabled: 0 and not saturated, even with a negative maxoutput
+    assert (out[~on] == 0).all() and not tr["pid.0.saturated"][~on].any()
+    if maxout != 0:
+        assert (np.abs(out[on]) <= abs(maxout)).all()
