@@ -196,6 +196,11 @@ static void set_gains(struct __comp_state *inst, double p, double i,
 #pragma pop_macro("cmd_d_est")
 #pragma pop_macro("fb_d_est")
 
+/* read bias as it is: the input pin names add 0, which turns a -0 bias
+   into +0 (the reference's output is -0 then) */
+#undef bias
+#define bias (*__comp_inst->bias)
+
 static inline double clamp(double v, double lim)
 {
     if (lim != 0.0) {
@@ -323,9 +328,16 @@ FUNCTION(do_pid_calcs)
         ei = 0;
         err_d = 0;
         prev_cmd = 0;
+        /* the command derivatives start from 0 again too */
+        cmd_d = 0;
+        cmd_dd = 0;
+        cmd_ddd = 0;
         if (debug) {
             errorI = 0;
             errorD = 0;
+            commandD = 0;
+            commandDD = 0;
+            commandDDD = 0;
         }
         tstate = T_IDLE;
         return;
@@ -371,11 +383,13 @@ FUNCTION(do_pid_calcs)
         o = bias + Pgain * e + Igain * ei + Dgain * err_d + FF0 * cmd
             + FF1 * cmd_d + FF2 * cmd_dd + FF3 * cmd_ddd;
     } else {
+        /* disabled: the output is zero and not saturated, whatever
+           maxoutput is (even a negative one, which would clamp 0) */
         o = 0;
         limit_dir = 0;
     }
 
-    if (maxoutput != 0.0) {
+    if (en && maxoutput != 0.0) {
         limit_dir = 0;
         if (o > maxoutput) {
             o = maxoutput;

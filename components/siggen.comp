@@ -75,6 +75,12 @@ license "GPL";
    reference does), so make that pin assignable here */
 #undef frequency
 #define frequency (*__comp_inst->frequency)
+/* and read amplitude and offset as they are: the input pin names add 0,
+   which turns a -0 into +0 (the reference keeps the sign of a -0 offset) */
+#undef amplitude
+#define amplitude (*__comp_inst->amplitude)
+#undef offset
+#define offset (*__comp_inst->offset)
 
 /* 2*pi rounded to eight digits: the reference's sine and cosine carry
    this rounding, which shows in their sixth decimal and in the sign of
@@ -91,7 +97,7 @@ FUNCTION(update) {
     double fmax = 0.5 / fperiod;
     double a = amplitude;
     double o = offset;
-    double p, w;
+    double p, w, s;
 
     /* above half the sample rate the phase would alias; clamp and let
        the user see it on the pin */
@@ -112,15 +118,17 @@ FUNCTION(update) {
     w = TURN * p;
     sine = a * sin(w) + o;
     cosine = a * cos(w) + o;
-    sawtooth = a * (2.0 * p - 1.0) + o;
+    /* the triangle is folded from the normalised sawtooth (2|2p-1| - 1),
+       which rounds as the reference does for large amplitudes */
+    s = 2.0 * p - 1.0;
+    sawtooth = a * s + o;
+    triangle = a * (2.0 * fabs(s) - 1.0) + o;
     if (p > 0.5) {
         clock = 1;
         square = a + o;
-        triangle = a * (4.0 * p - 3.0) + o;
     } else {
         clock = 0;
         square = o - a;
-        triangle = a * (1.0 - 4.0 * p) + o;
     }
 }
 

@@ -254,13 +254,20 @@ static void make_pulses(void *arg, long period)
         if (c->held && c->t_rev == 0)
             c->held = 0;
         /* ramp the add value; it stays put while a reversal waits */
-        if (!c->held && c->add != c->add_goal) {
+        if (!c->held) {
             add = c->add_goal;
             if (c->add_slew != 0) {
-                if (add > c->add + c->add_slew)
-                    add = c->add + c->add_slew;
-                else if (add < c->add - c->add_slew)
-                    add = c->add - c->add_slew;
+                /* the bounds wrap around, as two's complement sums do in
+                   the reference (only a NaN maxaccel or command gets near:
+                   then add alternates between the goal and 0 as there) */
+                long hi = (long)((unsigned long)c->add
+                                 + (unsigned long)c->add_slew);
+                long lo = (long)((unsigned long)c->add
+                                 - (unsigned long)c->add_slew);
+                if (add > hi)
+                    add = hi;
+                else if (add < lo)
+                    add = lo;
             }
             c->add = add;
         }
@@ -286,7 +293,10 @@ static void make_pulses(void *arg, long period)
         stepped = 0;
         if (!c->held) {
             acc = c->acc + add;
-            stepped = (acc >> FRAC) != (c->acc >> FRAC);
+            /* a step is a toggle of the step bit (at most one step a
+               period): a jump of the accumulator by a multiple of two
+               steps (a NaN command) makes none, as in the reference */
+            stepped = (int)(((acc ^ c->acc) >> FRAC) & 1);
             c->acc = acc;
             c->rawcount = acc >> FRAC;
         }

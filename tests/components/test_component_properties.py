@@ -411,3 +411,119 @@ def test_watchdog_ok_only_while_enabled_and_in_time(hal, en, x, k):
         elif ok[t] and not (t == 0 or not en[t - 1]):
             # ok-out turns TRUE only at a rising edge of enable-in
             assert ok[t - 1]
+
+
+@given(amp=finite, off=finite, freq=st.floats(0.0, 499.0))
+def test_siggen_waves_share_one_phase(hal, amp, off, freq):
+    # (a negative frequency runs the phase below 0 without end, as in the
+    # reference: the waves then leave their range)
+    once(hal, "siggen", "siggen.0.update")
+    hal.set({"siggen.0.amplitude": amp, "siggen.0.offset": off,
+             "siggen.0.frequency": freq, "siggen.0.reset": True})
+    hal.step(1)
+    hal.setp("siggen.0.reset", False)
+    tr = hal.run(N, record=["siggen.0.sawtooth", "siggen.0.triangle",
+                            "siggen.0.square", "siggen.0.clock"])
+    # the sawtooth gives the phase; the triangle folds it, the square and
+    # the clock split it at one half
+    s = (tr["siggen.0.sawtooth"] - off) / amp if amp else None
+    tol = 1e-6 * (abs(amp) + abs(off)) + 1e-9
+    if s is not None:
+        assert (np.abs(s) <= 1 + 1e-6).all()
+        tri = amp * (2 * np.abs(s) - 1) + off
+        assert np.allclose(tr["siggen.0.triangle"], tri, rtol=0, atol=tol)
+        high = s > 0
+        sure = np.abs(s) > 1e-6
+        assert (tr["siggen.0.clock"][sure] == high[sure]).all()
+    sq = np.where(tr["siggen.0.clock"], amp + off, off - amp)
+    assert np.allclose(tr["siggen.0.square"], sq, rtol=0, atol=tol)
+
+
+def _steps_made(tr, step_type):
+    """The signed number of steps in the recorded outputs of stepgen.0."""
+    def rises(x):
+        x = np.asarray(x, int)
+        return np.diff(np.concatenate([[0], x])) == 1
+    if step_type == 0:
+        up = rises(tr["stepgen.0.step"])
+        back = np.asarray(tr["stepgen.0.dir"], bool)
+        return int(up[~back].sum()) - int(up[back].sum())
+    if step_type == 1:
+        return int(rises(tr["stepgen.0.up"]).sum()
+                   - rises(tr["stepgen.0.down"]).sum())
+    # quadrature: the Gray code A/B moves one state a step
+    a = np.asarray(tr["stepgen.0.phase-A"], int)
+    b = np.asarray(tr["stepgen.0.phase-B"], int)
+    state = np.array([0, 1, 3, 2])[a * 2 + b]
+    d = np.diff(np.concatenate([[state[0]], state])) % 4
+    assert not (d == 2).any()
+    return int((d == 3).sum()) - int((d == 1).sum())
+
+
+@settings(max_examples=8, deadline=None,
+          suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(step_type=st.sampled_from([0, 1, 2]),
+       scale=st.floats(10.0, 500.0),
+       vel=st.floats(1000.0, 4000.0), acc=st.floats(5e4, 2e5),
+       targets=st.lists(st.integers(-60, 60), min_size=1, max_size=2),
+       frac=st.floats(-0.4, 0.4))
+def test_stepgen_steps_match_position_times_scale(hal, step_type, scale, vel,
+                                                  acc, targets, frac):
+    """Position mode: once the command has been still long enough to be
+    reached within maxvel and maxaccel, the steps made (counted on the
+    step outputs) are position-cmd * position-scale within one step."""
+    base, servo = 50_000, 1_000_000
+    hal.loadrt("stepgen", f"step_type={step_type}")
+    try:
+        hal.newthread("base", base, fp=False)
+        hal.newthread("servo", servo)
+        _stepgen_moves(hal, step_type, scale, vel, acc, targets, frac, base)
+    finally:
+        hal.unloadrt("stepgen")
+        for t in ("base", "servo"):
+            if hal.threads(t):
+                hal.delthread(t)
+
+
+def _stepgen_moves(hal, step_type, scale, vel, acc, targets, frac, base):
+    hal.addf("stepgen.make-pulses", "base")
+    hal.addf("stepgen.update-freq", "servo")
+    hal.addf("stepgen.capture-position", "servo")
+    # vel and acc in steps/s and steps/s^2, the limits in machine units
+    hal.set({"stepgen.0.position-scale": scale,
+             "stepgen.0.maxvel": vel / scale,
+             "stepgen.0.maxaccel": acc / scale,
+             "stepgen.0.enable": True})
+    here = 0.0
+    for t in targets:
+        goal = t + frac
+        d = abs(goal - here)
+        settle = vel / acc + d / vel + 2 * (d / acc) ** 0.5 + 0.01
+        n = int(settle * 1e9 / base) + 1
+        hal.setp("stepgen.0.position-cmd", goal / scale)
+        rec = {0: ["stepgen.0.step", "stepgen.0.dir"],
+               1: ["stepgen.0.up", "stepgen.0.down"],
+               2: ["stepgen.0.phase-A", "stepgen.0.phase-B"]}[step_type]
+        tr = hal.run(n, record=rec)
+        here += _steps_made(tr, step_type)
+        assert abs(here - goal) <= 1.0, (here, goal)
+
+
+@SETTINGS
+@given(cmd=signal, fb=signal, en=bits, maxout=finite,
+       gains=st.lists(st.floats(-100, 100), min_size=3, max_size=3))
+def test_pid_output_within_maxoutput_and_zero_when_disabled(
+        hal, cmd, fb, en, maxout, gains):
+    once(hal, "pid", "pid.0.do-pid-calcs", args=("num_chan=1",))
+    hal.set({"pid.0.Pgain": gains[0], "pid.0.Igain": gains[1],
+             "pid.0.FF1": gains[2], "pid.0.maxoutput": maxout})
+    tr = hal.run(N, inputs={"pid.0.command": np.array(cmd),
+                            "pid.0.feedback": np.array(fb),
+                            "pid.0.enable": np.array(en)},
+                 record=["pid.0.output", "pid.0.saturated"])
+    on = np.array(en)
+    out = tr["pid.0.output"]
+    # disabled: 0 and not saturated, even with a negative maxoutput
+    assert (out[~on] == 0).all() and not tr["pid.0.saturated"][~on].any()
+    if maxout != 0:
+        assert (np.abs(out[on]) <= abs(maxout)).all()
