@@ -349,3 +349,43 @@ def test_oneshot_pulse_is_width_cycles_after_each_edge(hal, x, w):
     want = np.array([edge[max(0, t - w + 1):t + 1].any() for t in range(N)])
     assert (tr["oneshot.0.out"] == want).all()
     assert (tr["oneshot.0.out-not"] == ~want).all()
+
+
+# values with NaN, infinities and exact ties, as the fuzzer drives them
+edgy = st.sampled_from([0.0, -0.0, 0.5, 1.0, -1.0, 2.0, 1e300, -1e300,
+                        float("inf"), float("-inf"), float("nan")]) | finite
+
+
+@SETTINGS
+@given(pos=st.lists(edgy, min_size=N, max_size=N), home=edgy, hyst=edgy,
+       maxlo=edgy, maxup=edgy, minlo=edgy, minup=edgy, offset=edgy,
+       homing=bits)
+def test_sim_axis_hardware_switches(hal, pos, home, hyst, maxlo, maxup,
+                                    minlo, minup, offset, homing):
+    """Each switch is TRUE unless a comparison puts the position outside:
+    a NaN anywhere turns it on, a position on a bound leaves a limit
+    switch off (as the reference)."""
+    once(hal, "sim_axis_hardware", "sim-axis-hardware.0.update")
+    j = "sim-axis-hardware.0.X"
+    hal.set({j + "homesw-pos": home, j + "homesw-hyst": hyst,
+             j + "maxsw-lower": maxlo, j + "maxsw-upper": maxup,
+             j + "minsw-lower": minlo, j + "minsw-upper": minup,
+             "sim-axis-hardware.0.limit-offset": offset})
+    outs = ["homesw-out", "maxsw-out", "minsw-out", "bothsw-out",
+            "bothsw-homesw-out"]
+    p = np.array(pos)
+    h = np.array(homing)
+    with np.errstate(invalid="ignore", over="ignore"):
+        d = p - home
+        exp_home = ~(d < -hyst * 0.5) & ~(d > hyst * 0.5)
+        exp_max = ~(p <= maxlo + offset) & ~(p >= maxup)
+        exp_min = ~(p <= minlo) & ~(p >= minup - offset)
+    tr = hal.run(N, inputs={j + "current-pos": p, j + "homing": h},
+                 record=[j + o for o in outs])
+    exp_both = (exp_max | exp_min) & ~h
+    assert (tr[j + "homesw-out"] == exp_home).all()
+    assert (tr[j + "maxsw-out"] == exp_max).all()
+    assert (tr[j + "minsw-out"] == exp_min).all()
+    assert (tr[j + "bothsw-out"] == exp_both).all()
+    assert (tr[j + "bothsw-homesw-out"] == (exp_both | exp_home)).all()
+
