@@ -389,3 +389,31 @@ def test_sim_axis_hardware_switches(hal, pos, home, hyst, maxlo, maxup,
     assert (tr[j + "bothsw-out"] == exp_both).all()
     assert (tr[j + "bothsw-homesw-out"] == (exp_both | exp_home)).all()
 
+
+@SETTINGS
+@given(speed=st.lists(edgy, min_size=N, max_size=N),
+       ppr=st.integers(1, 50))
+def test_sim_encoder_steps_are_quadrature(hal, speed, ppr):
+    """At most one count a period, each a single quadrature step in the
+    direction of the count; a NaN speed makes no step."""
+    if not hal.components("sim_encoder"):
+        setup(hal, "sim_encoder", "sim-encoder.make-pulses",
+              "sim-encoder.update-speed")
+    e = "sim-encoder.0."
+    hal.setp(e + "ppr", ppr)
+    raw0 = hal.getp(e + "rawcounts")
+    tr = hal.run(N, inputs={e + "speed": np.array(speed)},
+                 record=[e + "phase-A", e + "phase-B", e + "rawcounts"])
+    raw = np.concatenate([[raw0], tr[e + "rawcounts"]]).astype(np.int64)
+    # the quadrature states in counting order: (A, B) = 10 11 01 00
+    order = {(1, 0): 0, (1, 1): 1, (0, 1): 2, (0, 0): 3}
+    state = [order[(int(a), int(b))] for a, b in
+             zip(tr[e + "phase-A"], tr[e + "phase-B"])]
+    steps = np.diff(raw)
+    assert (np.abs(steps) <= 1).all()
+    for k in range(1, N):
+        assert (state[k] - state[k - 1]) % 4 == steps[k] % 4
+    # make-pulses runs first: a period steps on the previous period's speed
+    for k in range(1, N):
+        if np.isnan(speed[k - 1]):
+            assert steps[k] == 0
