@@ -417,3 +417,24 @@ def test_sim_encoder_steps_are_quadrature(hal, speed, ppr):
     for k in range(1, N):
         if np.isnan(speed[k - 1]):
             assert steps[k] == 0
+
+
+@SETTINGS
+@given(ins=st.lists(signal, min_size=4, max_size=4),
+       sel=st.lists(st.integers(0, 2**31 - 8), min_size=N, max_size=N),
+       selbits=st.lists(st.integers(0, 3), min_size=N, max_size=N))
+def test_mux_generic_copies_the_selected_input(hal, ins, sel, selbits):
+    """Without debounce, out is the input sel-int + sel-bits selects, the
+    last one for a selection past it; selected shows the number asked
+    for."""
+    once(hal, "mux_generic", "mux-gen.00", args=("config=ff4",))
+    m = "mux-gen.00."
+    hal.set({m + "debounce-us": 0, m + "suppress-no-input": False})
+    s = np.array(sel, dtype=np.int64) + np.array(selbits)
+    inputs = {f"{m}in-float-{k:02d}": np.array(ins[k]) for k in range(4)}
+    inputs[m + "sel-int"] = np.array(sel, dtype=np.uint32)
+    inputs.update({f"{m}sel-bit-{b:02d}": (np.array(selbits) >> b) & 1 == 1
+                   for b in range(2)})
+    out = hal.run(N, inputs=inputs, record=[m + "out-float"])[m + "out-float"]
+    assert (out == np.array(ins)[np.minimum(s, 3), np.arange(N)]).all()
+    assert hal.getp(m + "selected") == s[-1]
