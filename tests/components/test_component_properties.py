@@ -438,3 +438,18 @@ def test_mux_generic_copies_the_selected_input(hal, ins, sel, selbits):
     out = hal.run(N, inputs=inputs, record=[m + "out-float"])[m + "out-float"]
     assert (out == np.array(ins)[np.minimum(s, 3), np.arange(N)]).all()
     assert hal.getp(m + "selected") == s[-1]
+
+
+@SETTINGS
+@given(value=st.lists(edgy, min_size=N, max_size=N), rev=bits)
+def test_bldc_out_dir(hal, value, rev):
+    """out-dir is the sign of value turned round by rev, FALSE for 0 or
+    NaN (as the reference), from the first period on."""
+    once(hal, "bldc", "bldc.0", args=("cfg=a6",))
+    v = np.array(value)
+    r = np.array(rev)
+    out = hal.run(N, inputs={"bldc.0.value": v, "bldc.0.rev": r},
+                  record=["bldc.0.out-dir"])["bldc.0.out-dir"]
+    with np.errstate(invalid="ignore"):
+        exp = np.where(v > 0, r, np.where(v < 0, ~r, False))
+    assert (out == exp).all()
