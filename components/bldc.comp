@@ -182,7 +182,7 @@ pin out bit C8_out if (personality & 0x800) "Emulated Fanuc Gray code, bit 3";
 pin out float phase_angle = 0 "Angle of the field made by the phases, electrical revolutions (0 to 1), lead included: for drives that take an angle and a current";
 pin out float rotor_angle = 0 "Angle of the rotor, electrical revolutions (0 to 1): for drives that add their own lead, such as the Mesa 8i20";
 pin out float out "value, negated when rev is TRUE";
-pin out bit out_dir "TRUE when value is negative or rev is TRUE (not both)";
+pin out bit out_dir "TRUE when value is negative or rev is TRUE (not both); FALSE while value is 0 or NaN";
 pin out float out_abs "Absolute value of value";
 
 param r s32 in_type = -1 "Feedback mode in use, worked out in the first period (-1 before; -2: the letters make no usable feedback)";
@@ -320,6 +320,9 @@ FUNCTION(_) {
     int sine, valid = 1;
 
     out_abs = fabs(value);
+    /* out-dir, from the first period on, as the reference: the sign of
+       value turned round by rev, FALSE for a value of 0 or NaN */
+    out_dir = value > 0 ? (rev != 0) : (value < 0 ? (rev == 0) : 0);
     if (personality & 0x06)
         raw = rawcounts;
 
@@ -391,7 +394,6 @@ FUNCTION(_) {
 
     dir = (value < 0) ^ (rev != 0);
     out = dir ? -out_abs : out_abs;
-    out_dir = dir;
 
     sine = !(personality & P_TRAP) && (out_type & P_BITS) == 0;
     switch (in_type) {

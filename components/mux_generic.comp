@@ -36,7 +36,7 @@ power of two not above its size, e.g. 2 for 4 to 7 inputs""";
 pin in u32 sel-int """The selection as a number, added to the one on the sel-bit pins; a
 selection past the last input selects the last input""";
 param r u32 elapsed "How long the pending selection has been waiting, in microseconds";
-param r u32 selected "The number of the input being copied to the output";
+param r u32 selected "The selection in force: the number of the input copied to the output, or a number past the last input, which copies the last one";
 
 modparam dummy config """The multiplexers to make: a comma-separated list of entries like bb4 or
 fu12 (type of the inputs, type of the output, number of inputs); at most 100
@@ -147,11 +147,13 @@ static void update(void *arg, long period)
     /* all contacts of a switch open between two positions: hold */
     if (*m->suppress && s == 0)
         return;
-    if (s >= (rtapi_u32)m->size)
-        s = m->size - 1;
 
     /* a new selection waits for the debounce time; the time starts
-       afresh whenever the selection is back to the current one */
+       afresh whenever the selection is back to the current one.  As in
+       the reference, the selection compared (and shown by the selected
+       param) is the number asked for, before a number past the last input
+       is turned into the last input: moving from 9 to 10 on 8 inputs
+       waits too */
     if (s != m->chosen) {
         if (m->waited < *m->debounce) {
             m->waited += period / 1000;
@@ -160,6 +162,8 @@ static void update(void *arg, long period)
         m->chosen = s;
     }
     m->waited = 0;
+    if (s >= (rtapi_u32)m->size)
+        s = m->size - 1;
 
     if (m->in_type == T_FLOAT) {
         double v = *m->in[s].f;

@@ -33,6 +33,12 @@ Over all joints: \\fBhomesw-all\\fR is TRUE while some joint is homing
 and some joint is on its home switch (not necessarily the same one), \\fBlimitsw-all\\fR when any \\fIj\\fBbothsw-out\\fR
 is TRUE, and \\fBlimitsw-homesw-all\\fR when either of them is, for
 machines with all switches on one input.
+.PP
+As in the reference implementation, each switch is TRUE unless a
+comparison puts the position outside it: a NaN position, switch position,
+width, bound or offset turns the switch on, and a position exactly on a
+limit switch's bound (after the offset) leaves it off. A negative
+\\fIj\\fBhomesw-hyst\\fR never finds home.
 """;
 
 pin in float Xcurrent_pos "Position of the joint, for example joint.0.motor-pos-fb";
@@ -194,9 +200,13 @@ static struct joint_sw joint_switches(double pos, double home_pos,
 {
     struct joint_sw s;
 
-    s.home = fabs(pos - home_pos) <= hyst * 0.5;
-    s.max = pos > max_low + offset && pos < max_up;
-    s.min = pos > min_low && pos < min_up - offset;
+    /* written as the reference tests them, so that a NaN anywhere makes
+       a switch TRUE (no comparison with a NaN holds) and a position on a
+       bound leaves the limit switch FALSE */
+    s.home = !((pos - home_pos) < -hyst * 0.5) &&
+             !((pos - home_pos) > hyst * 0.5);
+    s.max = !(pos <= max_low + offset) && !(pos >= max_up);
+    s.min = !(pos <= min_low) && !(pos >= min_up - offset);
     s.both = (s.max || s.min) && !homing;
     return s;
 }

@@ -28,7 +28,8 @@ notes """
 A speed at or beyond the highest count rate (in either direction) makes
 the channel count downwards at the highest rate, as the reference
 implementation does. Keep the commanded count rate, |speed| / scale * ppr
-* 4, below 1e9 / (make-pulses period in ns).
+* 4, below 1e9 / (make-pulses period in ns). A NaN speed or scale stops
+the channel where it is (no steps), as in the reference.
 
 A scale between \\-1e\\-20 and 1e\\-20 is replaced by 1.0 when update-speed
 notices the change (the scale pin then reads 1). A scale of exactly 0
@@ -46,8 +47,8 @@ pin in s32 rawcounts "Count of the generated edges: the component adds one for e
 function make_pulses nofp "sim-encoder.make-pulses: make the quadrature steps of all channels; run it in a fast thread";
 function update_speed "sim-encoder.update-speed: read speed, scale and ppr of all channels and set their step rates";
 
-variable rtapi_s32 addval;
-variable rtapi_u32 accum;
+variable rtapi_s64 addval;
+variable rtapi_u64 accum;
 variable int state;
 variable int cycle;
 variable double old_scale;
@@ -82,12 +83,18 @@ static double rate_to_add;      /* accumulator units per (count/s) */
 FUNCTION(make_pulses) {
     pulse_period = period;
     FOR_ALL_INSTS() {
-        rtapi_u32 before = accum;
+        rtapi_u64 before = accum;
 
-        accum += (rtapi_u32)addval;
-        /* a step each time the accumulator passes a multiple of 2^31 */
-        if ((before ^ accum) & 0x80000000u) {
-            if (addval < 0) {
+        accum += (rtapi_u64)addval;
+        /* a step each time the accumulator passes a multiple of 2^31, as
+           bits 31 to 62 tell (the reference keeps 32 bits of accum >> 31):
+           the add value of a NaN speed, -2^63, changes only bit 63 and
+           makes no step */
+        if ((rtapi_u32)(before >> 31) != (rtapi_u32)(accum >> 31)) {
+            /* the direction is the low 32 bits of addval >> 31: +2^31
+               (the highest rate upwards) counts down, as in the
+               reference */
+            if ((rtapi_s32)(addval >> 31) != 0) {
                 raw_count--;
                 if (--state < 0) {
                     state = 3;
@@ -130,13 +137,13 @@ FUNCTION(update_speed) {
             rate = max_rate;
         else if (rate < -max_rate)
             rate = -max_rate;
-        /* a rate of +-max_rate is 2^31, which a 32-bit add value cannot
-           hold: like the reference, it becomes -2^31 */
+        /* +-max_rate is +-2^31; a NaN speed (no comparison above holds)
+           gives the x86 conversion of a NaN, -2^63, as in the reference */
         rate *= rate_to_add;
-        if (rate >= 2147483648.0 || rate < -2147483648.0)
-            addval = INT32_MIN;
+        if (rate != rate)
+            addval = INT64_MIN;
         else
-            addval = (rtapi_s32)rate;
+            addval = (rtapi_s64)rate;
     }
 }
 

@@ -527,3 +527,107 @@ def test_pid_output_within_maxoutput_and_zero_when_disabled(
     assert (out[~on] == 0).all() and not tr["pid.0.saturated"][~on].any()
     if maxout != 0:
         assert (np.abs(out[on]) <= abs(maxout)).all()
+
+
+# values with NaN, infinities and exact ties, as the fuzzer drives them
+edgy = st.sampled_from([0.0, -0.0, 0.5, 1.0, -1.0, 2.0, 1e300, -1e300,
+                        float("inf"), float("-inf"), float("nan")]) | finite
+
+
+@SETTINGS
+@given(pos=st.lists(edgy, min_size=N, max_size=N), home=edgy, hyst=edgy,
+       maxlo=edgy, maxup=edgy, minlo=edgy, minup=edgy, offset=edgy,
+       homing=bits)
+def test_sim_axis_hardware_switches(hal, pos, home, hyst, maxlo, maxup,
+                                    minlo, minup, offset, homing):
+    """Each switch is TRUE unless a comparison puts the position outside:
+    a NaN anywhere turns it on, a position on a bound leaves a limit
+    switch off (as the reference)."""
+    once(hal, "sim_axis_hardware", "sim-axis-hardware.0.update")
+    j = "sim-axis-hardware.0.X"
+    hal.set({j + "homesw-pos": home, j + "homesw-hyst": hyst,
+             j + "maxsw-lower": maxlo, j + "maxsw-upper": maxup,
+             j + "minsw-lower": minlo, j + "minsw-upper": minup,
+             "sim-axis-hardware.0.limit-offset": offset})
+    outs = ["homesw-out", "maxsw-out", "minsw-out", "bothsw-out",
+            "bothsw-homesw-out"]
+    p = np.array(pos)
+    h = np.array(homing)
+    with np.errstate(invalid="ignore", over="ignore"):
+        d = p - home
+        exp_home = ~(d < -hyst * 0.5) & ~(d > hyst * 0.5)
+        exp_max = ~(p <= maxlo + offset) & ~(p >= maxup)
+        exp_min = ~(p <= minlo) & ~(p >= minup - offset)
+    tr = hal.run(N, inputs={j + "current-pos": p, j + "homing": h},
+                 record=[j + o for o in outs])
+    exp_both = (exp_max | exp_min) & ~h
+    assert (tr[j + "homesw-out"] == exp_home).all()
+    assert (tr[j + "maxsw-out"] == exp_max).all()
+    assert (tr[j + "minsw-out"] == exp_min).all()
+    assert (tr[j + "bothsw-out"] == exp_both).all()
+    assert (tr[j + "bothsw-homesw-out"] == (exp_both | exp_home)).all()
+
+
+@SETTINGS
+@given(speed=st.lists(edgy, min_size=N, max_size=N),
+       ppr=st.integers(1, 50))
+def test_sim_encoder_steps_are_quadrature(hal, speed, ppr):
+    """At most one count a period, each a single quadrature step in the
+    direction of the count; a NaN speed makes no step."""
+    if not hal.components("sim_encoder"):
+        setup(hal, "sim_encoder", "sim-encoder.make-pulses",
+              "sim-encoder.update-speed")
+    e = "sim-encoder.0."
+    hal.setp(e + "ppr", ppr)
+    raw0 = hal.getp(e + "rawcounts")
+    tr = hal.run(N, inputs={e + "speed": np.array(speed)},
+                 record=[e + "phase-A", e + "phase-B", e + "rawcounts"])
+    raw = np.concatenate([[raw0], tr[e + "rawcounts"]]).astype(np.int64)
+    # the quadrature states in counting order: (A, B) = 10 11 01 00
+    order = {(1, 0): 0, (1, 1): 1, (0, 1): 2, (0, 0): 3}
+    state = [order[(int(a), int(b))] for a, b in
+             zip(tr[e + "phase-A"], tr[e + "phase-B"])]
+    steps = np.diff(raw)
+    assert (np.abs(steps) <= 1).all()
+    for k in range(1, N):
+        assert (state[k] - state[k - 1]) % 4 == steps[k] % 4
+    # make-pulses runs first: a period steps on the previous period's speed
+    for k in range(1, N):
+        if np.isnan(speed[k - 1]):
+            assert steps[k] == 0
+
+
+@SETTINGS
+@given(ins=st.lists(signal, min_size=4, max_size=4),
+       sel=st.lists(st.integers(0, 2**31 - 8), min_size=N, max_size=N),
+       selbits=st.lists(st.integers(0, 3), min_size=N, max_size=N))
+def test_mux_generic_copies_the_selected_input(hal, ins, sel, selbits):
+    """Without debounce, out is the input sel-int + sel-bits selects, the
+    last one for a selection past it; selected shows the number asked
+    for."""
+    once(hal, "mux_generic", "mux-gen.00", args=("config=ff4",))
+    m = "mux-gen.00."
+    hal.set({m + "debounce-us": 0, m + "suppress-no-input": False})
+    s = np.array(sel, dtype=np.int64) + np.array(selbits)
+    inputs = {f"{m}in-float-{k:02d}": np.array(ins[k]) for k in range(4)}
+    inputs[m + "sel-int"] = np.array(sel, dtype=np.uint32)
+    inputs.update({f"{m}sel-bit-{b:02d}": (np.array(selbits) >> b) & 1 == 1
+                   for b in range(2)})
+    out = hal.run(N, inputs=inputs, record=[m + "out-float"])[m + "out-float"]
+    assert (out == np.array(ins)[np.minimum(s, 3), np.arange(N)]).all()
+    assert hal.getp(m + "selected") == s[-1]
+
+
+@SETTINGS
+@given(value=st.lists(edgy, min_size=N, max_size=N), rev=bits)
+def test_bldc_out_dir(hal, value, rev):
+    """out-dir is the sign of value turned round by rev, FALSE for 0 or
+    NaN (as the reference), from the first period on."""
+    once(hal, "bldc", "bldc.0", args=("cfg=a6",))
+    v = np.array(value)
+    r = np.array(rev)
+    out = hal.run(N, inputs={"bldc.0.value": v, "bldc.0.rev": r},
+                  record=["bldc.0.out-dir"])["bldc.0.out-dir"]
+    with np.errstate(invalid="ignore"):
+        exp = np.where(v > 0, r, np.where(v < 0, ~r, False))
+    assert (out == exp).all()
