@@ -413,6 +413,7 @@ def test_watchdog_ok_only_while_enabled_and_in_time(hal, en, x, k):
             assert ok[t - 1]
 
 
+@SETTINGS
 @given(amp=finite, off=finite, freq=st.floats(0.0, 499.0))
 def test_siggen_waves_share_one_phase(hal, amp, off, freq):
     # (a negative frequency runs the phase below 0 without end, as in the
