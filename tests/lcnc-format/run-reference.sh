@@ -23,13 +23,8 @@
 set -u
 here=$(cd "$(dirname "$0")" && pwd)
 top=$(cd "$here/../.." && pwd)
-REFERENCE=${REFERENCE:-}
-if [ -z "$REFERENCE" ]; then
-    for r in "$top/../shared/tools/reference" /work/shared/tools/reference; do
-        if [ -x "$r" ]; then REFERENCE=$r; break; fi
-    done
-fi
-if [ -z "$REFERENCE" ] || ! [ -x "$REFERENCE" ]; then
+REFERENCE=${REFERENCE:-$top/../shared/tools/reference}
+if ! [ -x "$REFERENCE" ]; then
     echo "run-reference.sh: the reference tool was not found (set REFERENCE)" >&2
     exit 2
 fi
