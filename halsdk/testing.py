@@ -14,14 +14,21 @@ The ``hal`` fixture creates an instance of its own (``HALSDK_INSTANCE`` is
 set for the test, so child processes and :func:`halsdk.component` find it),
 and removes it afterwards.  At the end of the session the plugin fails the
 run if an instance it created is still in ``/dev/shm``.
+
+SIGTERM (and SIGHUP) stop the whole run as Ctrl-C does: the running test
+is interrupted, no further test starts, the fixtures are torn down (so
+every instance is removed) and pytest exits with 128 + the signal number.
 """
 
 from __future__ import annotations
 
 import itertools
 import os
+import signal
+import threading
 from collections.abc import Iterable, Mapping, Sequence
-from typing import Any, Optional
+from types import FrameType
+from typing import Any, Callable, Optional, Union
 
 import numpy as np
 import pytest
@@ -112,10 +119,49 @@ def private_instance_name() -> str:
     return f"pytest-{os.getpid()}-{next(_counter)}"
 
 
+_Handler = Union[Callable[[int, Optional[FrameType]], Any], int, None]
+_STOP_SIGNALS = (signal.SIGTERM, signal.SIGHUP)
+_previous_handlers: dict[int, _Handler] = {}
+_stopping = False
+
+
+def _stop_run(signum: int, frame: Optional[FrameType]) -> None:
+    """Stop the session cleanly: pytest's Exit is not a test failure, ends
+    the run, and still tears the fixtures down.  A second signal while
+    that teardown runs is ignored, so it cannot cut the teardown short."""
+    global _stopping
+    if _stopping:
+        return
+    _stopping = True
+    name = signal.Signals(signum).name
+    pytest.exit(f"halsdk: stopped by {name}; removing the test instances",
+                returncode=128 + signum)
+
+
+def _install_stop_handlers() -> None:
+    """Only where nobody else handles the signal: a project's own handler
+    (or pytest-timeout's) is left alone."""
+    if threading.current_thread() is not threading.main_thread():
+        return
+    for signum in _STOP_SIGNALS:
+        if signal.getsignal(signum) is signal.SIG_DFL:
+            _previous_handlers[signum] = signal.signal(signum, _stop_run)
+
+
 def pytest_configure(config: pytest.Config) -> None:
     config.addinivalue_line(
         "markers", "hal_size(nbytes): size of the test's private HAL "
         "instance (the hal fixture), when the default is too small")
+    _install_stop_handlers()
+
+
+def pytest_unconfigure(config: pytest.Config) -> None:
+    global _stopping
+    while _previous_handlers:
+        signum, handler = _previous_handlers.popitem()
+        if signal.getsignal(signum) is _stop_run:
+            signal.signal(signum, handler)
+    _stopping = False
 
 
 @pytest.fixture
@@ -147,8 +193,12 @@ def leftover_instances(shm_names: Iterable[str]) -> list[str]:
             if os.path.exists("/dev/shm/" + n.lstrip("/"))]
 
 
+@pytest.hookimpl(trylast=True)
 def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
+    """After pytest's own teardown of the fixtures (trylast), so that a
+    run stopped half-way is checked once its instances are gone."""
     left = leftover_instances(_created)
     if left:
         print(f"\nhalsdk: HAL instances left in /dev/shm: {', '.join(left)}")
-        session.exitstatus = 1
+        if not session.exitstatus:
+            session.exitstatus = 1

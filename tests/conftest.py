@@ -32,6 +32,7 @@ def pytest_sessionstart(session: pytest.Session) -> None:
     _before.update(_halsdk_segments())
 
 
+@pytest.hookimpl(trylast=True)
 def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
     """The suite ends by checking that no test left an instance behind."""
     left = sorted(_halsdk_segments() - _before)

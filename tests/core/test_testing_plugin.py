@@ -76,3 +76,57 @@ def test_plugin_in_another_project(pytester):
     result.stdout.fnmatch_lines(["*HAL instances left in /dev/shm*"])
     leaked = (pytester.path / "leaked.txt").read_text()
     os.unlink("/dev/shm" + halsdk.core.instance.shm_name(leaked))
+
+
+STOPPABLE_PROJECT = """
+import pathlib
+import time
+
+def test_first(hal):
+    hal.loadrt("and2")
+    hal.newthread("servo", 1_000_000)
+    hal.addf("and2.0", "servo")
+    hal.start()
+    pathlib.Path("started").write_text(hal.instance)
+    time.sleep(60)
+
+def test_second(hal):
+    pathlib.Path("second-ran").write_text("yes")
+
+def test_third(hal):
+    pass
+"""
+
+
+@pytest.mark.parametrize("signame", ["SIGTERM", "SIGHUP"])
+def test_a_stopped_run_ends_cleanly(tmp_path, signame):
+    """SIGTERM (or a closed terminal's SIGHUP) during a test that uses the
+    hal fixture stops the run as Ctrl-C does: no further test starts, no
+    failure is invented, no traceback, and the instance is removed."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    (tmp_path / "test_stoppable.py").write_text(STOPPABLE_PROJECT)
+    env = {k: v for k, v in os.environ.items() if k != "HALSDK_INSTANCE"}
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider",
+         "test_stoppable.py"], cwd=tmp_path, env=env,
+        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    started = tmp_path / "started"
+    deadline = time.monotonic() + 60
+    while not started.exists() and proc.poll() is None \
+            and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert started.exists(), proc.communicate(timeout=30)[0]
+    time.sleep(0.1)             # the instance name is written: in the test
+    instance = started.read_text()
+    proc.send_signal(getattr(signal, signame))
+    out, _ = proc.communicate(timeout=30)
+    assert proc.returncode == 128 + getattr(signal, signame), out
+    assert f"stopped by {signame}" in out
+    assert "Traceback" not in out and "SystemExit" not in out, out
+    assert "failed" not in out, out
+    assert not (tmp_path / "second-ran").exists()
+    assert not any(instance in n for n in os.listdir("/dev/shm")), out
