@@ -269,6 +269,36 @@ def test_enable_with_a_fault_raises_the_reason(hal, machine, pins, joint,
     assert m.status().enabled
 
 
+def test_enable_with_a_misc_error_raises_the_reason(hal):
+    """A misc-error input that is true disables motion at once: enable()
+    says which input."""
+    hal.loadrt("trivkins")
+    hal.loadrt("homemod")
+    hal.loadrt("tpmod")
+    hal.loadrt("motmod", servo_period_nsec=1_000_000, num_joints=1,
+               num_misc_error=3)
+    hal.addf("motion-command-handler", "servo-thread")
+    hal.addf("motion-controller", "servo-thread")
+    hal.net("fb0", "joint.0.motor-pos-cmd", "joint.0.motor-pos-fb")
+    m = Motion.connect(hal)
+    hal.set({"motion.misc-error-02": True})
+    with pytest.raises(EnableFailed) as e:
+        m.enable()
+    assert (e.value.joint, e.value.fault) == (None, "misc-error")
+    assert "motion.misc-error-02 is true" in str(e.value)
+    assert not m.status().enabled
+    hal.set({"motion.misc-error-02": False})
+    m.enable()
+    assert m.status().enabled
+
+
+def test_enable_with_motion_enable_false_is_refused(hal, machine):
+    hal.set({"motion.enable": False})
+    with pytest.raises(Rejected, match="motion.enable is false"):
+        machine.enable()
+    assert not machine.status().enabled
+
+
 def test_enable_with_limits_overridden_stays_enabled(hal, machine):
     m = machine
     hal.set({"joint.1.pos-lim-sw-in": True})
