@@ -164,7 +164,7 @@ class Run:
             if r is not None and r.returncode == 0 and \
                     r.stdout.strip() not in ("", "0"):
                 return True
-            time.sleep(0.02)
+            time.sleep(0.05)
         return False
 
     def component_pid(self) -> Optional[int]:
@@ -321,8 +321,9 @@ def one(target: str, signame: str, rng: random.Random,
                         pass
                     proc.kill()
                     proc.wait()
-            subprocess.run([_console("halrun"), "-U"], cwd=folder,
-                           env=run.env, capture_output=True, timeout=60)
+            if run.leftovers():     # tidy a run that went wrong
+                subprocess.run([_console("halrun"), "-U"], cwd=folder,
+                               env=run.env, capture_output=True, timeout=60)
         return run.findings
 
 
