@@ -140,10 +140,9 @@ def _files(*patterns: str) -> list[str]:
 
 # ------------------------------------------------------------ HAL files
 
-#: commands that would start programs, read other files or wait for
-#: something outside the input: the campaign feeds HAL text, not a shell
-_HAL_SKIPPED = ("loadusr", "waitusr", "unloadusr", "source", "loadrt "
-                "threads name1=x period1=0")
+#: commands that would start programs or wait for something outside the
+#: input: the campaign feeds HAL text, not a shell
+_HAL_SKIPPED = ("loadusr", "waitusr", "unloadusr")
 
 
 def _hal_corpus() -> list[str]:

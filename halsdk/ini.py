@@ -32,7 +32,9 @@ class IniFile:
         self.headers: list[tuple[str, int]] = []
         section = ""
         with open(path, encoding="utf-8", errors="replace") as f:
-            rows = [row.rstrip("\n") for row in f]
+            # a NUL character ends its line, as in the reference's C
+            # strings (and a file name never holds one)
+            rows = [row.rstrip("\n").split("\0", 1)[0] for row in f]
         at = 0
         while at < len(rows):
             raw = rows[at]

@@ -138,5 +138,7 @@ def split_words(line: str) -> list[str]:
 
 def tokenize(line: str, ini: Optional[IniFile] = None) -> list[str]:
     """The words of one logical line: comments removed, then variables
-    substituted in the whole line, then split (as the reference does)."""
-    return split_words(substitute(strip_comment(line), ini))
+    substituted in the whole line, then split (as the reference does).
+    A NUL character ends the line, as it ends the reference's C string."""
+    return split_words(substitute(strip_comment(line.split("\0", 1)[0]),
+                                  ini))

@@ -51,3 +51,15 @@ def test_a_backslash_continues_a_value(tmp_path):
     assert ini.get("HALUI", "NEXT") == "1"
     assert ini.where("HALUI", "NEXT") == f"{path}:5"
     assert ini.get("HALUI", "LAST") == "a\\"        # no line follows
+
+
+def test_a_nul_character_ends_its_line(tmp_path):
+    """As in the reference's C strings: the rest of the line is not read,
+    and nothing downstream gets a value it cannot use as a file name."""
+    path = tmp_path / "m.ini"
+    path.write_bytes(b"[HAL]\nHALFILE = mi\x00ll.hal\nTWOPASS = on\x00\n"
+                     b"[EMC]\x00junk\nMACHINE = m\n")
+    ini = IniFile(str(path))
+    assert ini.get("HAL", "HALFILE") == "mi"
+    assert ini.get("HAL", "TWOPASS") == "on"
+    assert ini.get("EMC", "MACHINE") == "m"

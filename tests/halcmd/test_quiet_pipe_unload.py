@@ -115,3 +115,29 @@ def test_unload_all_spares_other_halcmd_sessions(hal, tmp_path):
         if waiting.poll() is None:
             waiting.kill()
             waiting.wait()
+
+
+def test_a_nul_in_a_hal_line_ends_the_line(tmp_path):
+    """A NUL ends a line as it ends the reference's C string: no
+    ValueError traceback from a file name that holds one."""
+    instance = f"i19-nul-{os.getpid()}"
+    env = dict(os.environ, HALSDK_INSTANCE=instance)
+    (tmp_path / "nul.hal").write_bytes(
+        b"loadrt and2\nshow pin and2.0.in\x000\nsource a\x00b.hal\n")
+    r = subprocess.run([_program("halrun"), "-f", "nul.hal"], cwd=tmp_path,
+                       env=env, capture_output=True, text=True, timeout=60)
+    assert "and2.0.in0" in r.stdout and "and2.0.in1" in r.stdout
+    assert r.returncode == 1
+    assert "Could not open hal file 'a'" in r.stderr
+    assert "Traceback" not in r.stderr
+
+
+def test_halsdk_run_with_a_nul_in_halfile(tmp_path):
+    (tmp_path / "m.ini").write_bytes(
+        b"[EMC]\nMACHINE = m\n[HAL]\nHALFILE = mi\x00ll.hal\n")
+    env = dict(os.environ, HALSDK_INSTANCE=f"i19-nulrun-{os.getpid()}")
+    r = subprocess.run([_program("halsdk"), "run", "m.ini"], cwd=tmp_path,
+                       env=env, capture_output=True, text=True, timeout=60)
+    assert r.returncode != 0
+    assert "m.ini:4: cannot read HAL file 'mi'" in r.stderr
+    assert "Traceback" not in r.stderr
