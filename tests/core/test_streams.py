@@ -353,12 +353,23 @@ def test_halsampler_waits_for_data_and_reports_removal(hal, tmp_path):
         [sys.executable, "-m", "halsdk.tools.halsampler", "-n", "3"],
         cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
         text=True)
+    stream = hal.find("stream", "sampler.0")
+
+    def taken() -> None:
+        """Until halsampler has read what is in the stream (a loaded
+        machine may take long to start it)."""
+        deadline = time.monotonic() + 30
+        while stream.depth and time.monotonic() < deadline:
+            assert proc.poll() is None, proc.communicate()
+            time.sleep(0.01)
+
     try:
         hal.step(1)
-        time.sleep(0.5)               # it has one record and waits
+        taken()
+        time.sleep(0.2)               # it has one record and waits
         assert proc.poll() is None
         hal.step(1)
-        time.sleep(0.2)
+        taken()
         hal.unloadrt("sampler")       # the stream goes away under it
         out, err = proc.communicate(timeout=20)
     finally:
