@@ -34,6 +34,7 @@ from halsdk.errors import (
                            NotPermittedError,
                            Rule,
                            StaleError,
+                           TrustError,
 )
 from halsdk.hal import Hal, check_name
 from halsdk.types import Direction, HalType
@@ -63,5 +64,5 @@ __all__ = [
     "RW", "NAME_LEN", "REFERENCE_NAME_LEN",
     "HalError", "NotFoundError", "ExistsError", "HalTypeError",
     "ConflictError", "NotPermittedError", "InvalidError", "CapacityError",
-    "InstanceError", "StaleError", "LoadError",
+    "InstanceError", "StaleError", "LoadError", "TrustError",
 ]

@@ -574,7 +574,9 @@ class Hal:
     def private_socket_path(self, purpose: str) -> str:
         """The path of a Unix socket of this instance for ``purpose``
         (``"task"``: the machine's command channel), in the user's private
-        runtime folder (mode 0700), beside the host's request socket."""
+        runtime folder (mode 0700), beside the host's request socket.
+        TrustError when that folder is another user's, a link, or open to
+        others (docs/concepts.rst, "the trust checks")."""
         if purpose not in channel.SOCKET_PURPOSES:
             raise InvalidError(f"socket purpose {purpose!r}: one of "
                                f"{', '.join(channel.SOCKET_PURPOSES)}")

@@ -25,7 +25,7 @@ import threading
 import time
 from typing import Any, NoReturn, Optional
 
-from halsdk.channels import cmdproto
+from halsdk.channels import cmdproto, sockfile
 from halsdk.channels.cmdproto import (
     PROTOCOL_VERSION,
     RCS_DONE,
@@ -106,6 +106,10 @@ class CommandClient:
 
     def _connect(self) -> None:
         path, instance = self.path, _instance_of(self.path)
+        refused = sockfile.refusal(path)
+        if refused is not None:
+            raise ChannelError(f"cannot reach the task of instance "
+                               f"{instance}: {refused}")
         self._sock.settimeout(self.timeout)
         try:
             self._sock.connect(path)

@@ -30,7 +30,7 @@ import struct
 import time
 from typing import Callable, Optional
 
-from halsdk.channels import cmdproto
+from halsdk.channels import cmdproto, sockfile
 from halsdk.channels.cmdproto import (
     RCS_ERROR,
     RCS_EXEC,
@@ -403,6 +403,10 @@ def _clear_stale(path: str) -> None:
             f"cannot create the task's command channel at {path}: a file "
             "that is not a socket is in the way; remove it if it is not "
             "needed")
+    refused = sockfile.refusal(path)
+    if refused is not None:
+        raise ChannelError(
+            f"cannot create the task's command channel: {refused}")
     probe = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
     probe.settimeout(1.0)
     try:

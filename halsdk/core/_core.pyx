@@ -1001,10 +1001,14 @@ def probe(str shm_name):
     """What is at a shared-memory name, as ``(state, host_pid, host_start,
     abi)``; state is ``"absent"``, ``"creating"`` (being created),
     ``"junk"`` (not a halsdk instance), ``"abi"`` (an instance of another
-    ABI version) or ``"ok"``."""
+    ABI version) or ``"ok"``.  A segment that fails the trust checks (not
+    owned by the effective user, not mode 0600, more than one link, a
+    symbolic link or not a regular file) raises TrustError."""
     cdef int pid = 0, abi = 0
     cdef uint64_t start = 0
     r = hal_instance_probe(enc(shm_name), &pid, &start, &abi)
+    if r == -13:
+        raise error_of(r)
     state = {0: "ok", -2: "absent", -11: "creating", -71: "junk",
              -93: "abi"}.get(r, "junk")
     return state, pid, start, abi

@@ -18,12 +18,11 @@ from __future__ import annotations
 import json
 import os
 import socket
-import stat
 import struct
 import threading
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Callable, Optional
 
-from halsdk.core import errors
+from halsdk.core import errors, trust
 
 if TYPE_CHECKING:
     from halsdk.core.instance import Connection
@@ -32,24 +31,10 @@ _MAX_REQUEST = 1 << 20
 
 
 def socket_dir() -> str:
-    """The private directory of this user's request sockets."""
-    base = os.environ.get("XDG_RUNTIME_DIR")
-    if base and os.path.isdir(base) and os.access(base, os.W_OK):
-        path = os.path.join(base, "halsdk")
-    else:
-        path = f"/tmp/halsdk-{os.getuid()}"
-    try:
-        os.mkdir(path, 0o700)
-    except FileExistsError:
-        pass
-    st = os.lstat(path)
-    if not stat.S_ISDIR(st.st_mode) or st.st_uid != os.getuid():
-        raise errors.InstanceError(
-            f"{path} is not a directory owned by this user; refusing to "
-            "use it for the HAL request channel")
-    if stat.S_IMODE(st.st_mode) & 0o077:
-        os.chmod(path, 0o700)
-    return path
+    """The private directory of this user's request sockets (mode 0700,
+    see :func:`halsdk.core.trust.runtime_dir`); TrustError when another
+    user made it, or it is a link or open to others."""
+    return trust.runtime_dir()
 
 
 def socket_path(shm: str) -> str:
@@ -61,20 +46,32 @@ def socket_path(shm: str) -> str:
 SOCKET_PURPOSES = ("task",)
 
 
-def remove_socket(shm: str) -> None:
+def remove_socket(shm: str,
+                  report: Optional[Callable[[str], None]] = None) -> None:
     """Remove the request socket of instance ``shm`` and its other
     sockets (:data:`SOCKET_PURPOSES`), as the host does at exit and
-    ``halrun -U`` after a crash."""
+    ``halrun -U`` after a crash.  A file there that is not a socket of
+    this user (or a runtime folder that is not ours) is left in place and
+    passed to ``report`` in words."""
     try:
         path = socket_path(shm)
-    except errors.InstanceError:
+    except errors.InstanceError as exc:
+        if report is not None:
+            report(str(exc))
         return
     base = path[:-len(".sock")]
     for name in (path, *(f"{base}.{p}.sock" for p in SOCKET_PURPOSES)):
         try:
+            trust.check_socket(name)
             os.unlink(name)
         except FileNotFoundError:
             pass
+        except errors.InstanceError as exc:
+            if report is not None:
+                report(str(exc))
+        except OSError as exc:
+            if report is not None:
+                report(f"cannot remove {name}: {exc.strerror or exc}")
 
 
 class Server:
@@ -84,6 +81,7 @@ class Server:
     def __init__(self, conn: Connection) -> None:
         self.conn = conn
         self.path = socket_path(conn.shm)
+        trust.check_socket(self.path)   # a stale one of ours is replaced
         try:
             os.unlink(self.path)
         except FileNotFoundError:
@@ -92,9 +90,15 @@ class Server:
         old = os.umask(0o077)
         try:
             self.sock.bind(self.path)
+            self.sock.listen(16)
+        except OSError as exc:
+            self.sock.close()
+            raise errors.InstanceError(
+                f"cannot make the request socket {self.path}: "
+                f"{exc.strerror or exc} (a shorter runtime folder: set "
+                "HALSDK_RUNTIME_DIR or XDG_RUNTIME_DIR)") from None
         finally:
             os.umask(old)
-        self.sock.listen(16)
         self.sock.settimeout(0.2)
         self.stopping = False
         self.thread = threading.Thread(target=self._serve,
@@ -144,8 +148,16 @@ class Server:
     def _handle(self, client: socket.socket) -> None:
         creds = client.getsockopt(socket.SOL_SOCKET, socket.SO_PEERCRED,
                                   struct.calcsize("3i"))
-        _pid, uid, _gid = struct.unpack("3i", creds)
-        if uid != os.getuid():
+        pid, uid, _gid = struct.unpack("3i", creds)
+        if uid != os.geteuid():
+            # only the host's own user may use its instance: say so to the
+            # client (the socket's folder keeps others out; root passes)
+            why = (f"the host of this HAL instance runs as "
+                   f"{trust.me_words()}; pid {pid} of "
+                   f"{trust.owner_words(uid)} may not use it")
+            client.sendall(json.dumps(
+                {"ok": False, "class": "TrustError",
+                 "error": why}).encode() + b"\n")
             return
         reader = client.makefile("rb")
         while True:
@@ -185,6 +197,7 @@ def request(shm: str, op: str, *args: Any, timeout: float = 60.0,
             **kwargs: Any) -> Any:
     """Ask the host of an instance to do ``op``; raise its error."""
     path = socket_path(shm)
+    trust.check_socket(path)
     sock = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
     sock.settimeout(timeout)
     try:

@@ -103,6 +103,13 @@ class InstanceError(HalError):
     """No instance, an incompatible one (ABI version), or a dead host."""
 
 
+class TrustError(InstanceError):
+    """A shared-memory segment, socket or runtime folder that this process
+    does not trust: not owned by the effective user, the wrong mode, more
+    than one hard link, or a symbolic link.  The message names the check
+    that failed, the file and its owner."""
+
+
 class StaleError(HalError):
     """A handle whose object has been deleted."""
 
@@ -124,6 +131,7 @@ ERRNO_CLASS: dict[int, Callable[..., HalError]] = {
     22: InvalidError,           # EINVAL
     71: InstanceError,          # EPROTO
     19: InstanceError,          # ENODEV
+    13: TrustError,             # EACCES: the trust checks of a segment
 }
 
 
@@ -146,5 +154,6 @@ __all__ = [
     "NotPermittedError",
     "Rule",
     "StaleError",
+    "TrustError",
     "error_for_errno",
 ]

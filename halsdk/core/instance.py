@@ -187,7 +187,8 @@ def _take_over(shm: str, label: str, pid: int) -> bool:
 
     path = SHM_DIR + shm
     try:
-        fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_CLOEXEC)
+        fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK
+                     | os.O_CLOEXEC)
     except FileNotFoundError:
         return True             # gone already: create it
     except OSError:
@@ -272,20 +273,36 @@ def _install_sigterm() -> None:
 
 def _older_than(name: str, seconds: float) -> bool:
     try:
-        st = os.stat(os.path.join(SHM_DIR, name))
+        st = os.lstat(os.path.join(SHM_DIR, name))
     except FileNotFoundError:
         return False
     return time.time() - st.st_mtime > seconds
 
 
-def cleanup(instance: Optional[str] = None) -> list[str]:
+def cleanup(instance: Optional[str] = None,
+            report: Optional[Callable[[str], None]] = None) -> list[str]:
     """Remove instances of this user whose host process is gone.
 
     With ``instance`` only that one is considered.  Returns the names of
     the shared-memory segments removed.  Instances with a live host are
-    left alone.
+    left alone.  A segment or socket that fails the trust checks (another
+    user's file, a link, the wrong mode: see :class:`TrustError`), a
+    runtime folder that is not this user's, and a file that cannot be
+    removed are left in place and passed to ``report`` (when given), one
+    message each, naming the file and its owner.
     """
     from halsdk.core import channel
+
+    def say(message: str) -> None:
+        if report is not None:
+            report(message)
+
+    try:
+        channel.socket_dir()
+        sockets: Optional[Callable[[str], None]] = say
+    except InstanceError as exc:
+        say(str(exc))           # the folder is not ours: leave it be
+        sockets = None
 
     prefix = f"halsdk-{os.getuid()}"
     if instance is not None:
@@ -301,7 +318,11 @@ def cleanup(instance: Optional[str] = None) -> list[str]:
         shm = "/" + n
         if _conn is not None and _conn.shm == shm:
             continue
-        state, pid, start, _abi = _core.probe(shm)
+        try:
+            state, pid, start, _abi = _core.probe(shm)
+        except InstanceError as exc:
+            say(str(exc))       # not ours to judge, or to remove
+            continue
         if state in ("absent", "abi"):
             continue            # another version's instance is not ours
         if state == "ok" and _core.pid_alive(pid, start):
@@ -313,5 +334,9 @@ def cleanup(instance: Optional[str] = None) -> list[str]:
             removed.append(n)
         except FileNotFoundError:
             pass
-        channel.remove_socket(shm)
+        except OSError as exc:
+            say(f"cannot remove {SHM_DIR}/{n}: {exc.strerror or exc}")
+            continue
+        if sockets is not None:
+            channel.remove_socket(shm, sockets)
     return removed

@@ -268,7 +268,7 @@ def halcmd_main(argv: Optional[list[str]] = None) -> int:
 
 def _halcmd_main(argv: Optional[list[str]] = None) -> int:
     from halsdk import Hal
-    from halsdk.errors import HalError
+    from halsdk.errors import HalError, TrustError
     argv = sys.argv[1:] if argv is None else argv
     opts = _parse(argv, "halcmd")
     if opts.release_only:
@@ -279,6 +279,9 @@ def _halcmd_main(argv: Optional[list[str]] = None) -> int:
         return _check(opts, "halcmd")
     try:
         hal = Hal(create=False)
+    except TrustError as exc:
+        print(f"halcmd: {exc}", file=sys.stderr)
+        return 1
     except HalError as exc:
         print(f"halcmd: no HAL instance to attach to ({exc}); "
               "start one with halrun", file=sys.stderr)
@@ -290,6 +293,11 @@ def _halcmd_main(argv: Optional[list[str]] = None) -> int:
             return _run(ex, opts, "halcmd")
         finally:
             ex.unregister()
+
+
+#: the words of the error of creating an instance that has a live host
+#: (halsdk.core.instance), the one case where another halrun is the cause
+_ANOTHER_HOST = "already has a host"
 
 
 def halrun_main(argv: Optional[list[str]] = None) -> int:
@@ -304,8 +312,14 @@ def _halrun_main(argv: Optional[list[str]] = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     opts = _parse(argv, "halrun")
     if opts.cleanup:
-        halsdk.cleanup()
-        return 0
+        # files that are not ours (another user's, links, junk) are named
+        # and left in place; the exit status says that something was left
+        # (the reference's -U always ends with 0: it has no such files)
+        left: list[str] = []
+        halsdk.cleanup(report=left.append)
+        for message in left:
+            print(f"halrun: {message}", file=sys.stderr)
+        return 1 if left else 0
     if opts.release_only:
         return 0
     if _ini_missing(opts):
@@ -320,9 +334,11 @@ def _halrun_main(argv: Optional[list[str]] = None) -> int:
     try:
         hal = Hal(create=True)
     except HalError as exc:
-        print(f"halrun: cannot create the HAL instance: {exc}\n"
-              "halrun: is another halrun running? ('halrun -U' removes "
-              "instances of dead processes)", file=sys.stderr)
+        print(f"halrun: cannot create the HAL instance: {exc}",
+              file=sys.stderr)
+        if _ANOTHER_HOST in str(exc):
+            print("halrun: is another halrun running? ('halrun -U' removes "
+                  "instances of dead processes)", file=sys.stderr)
         return 1
     with hal:
         ex = CommandRunner(hal, keep_going=opts.keep_going, script=opts.script,

@@ -18,6 +18,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <pwd.h>
 #include <signal.h>
 #include <sys/mman.h>
 #include <sys/stat.h>
@@ -1902,6 +1903,110 @@ static void recover_after_dead_holder(void)
 /* ---------------------------------------------------------------- */
 /* instance                                                         */
 
+/*
+ * The trust boundary: a process maps only a segment that the effective
+ * user owns, of mode 0600, with one link, that is a regular file and not a
+ * symbolic link.  The checks are made on the opened descriptor (opened
+ * with O_NOFOLLOW), so nothing can be swapped between check and map; root
+ * passes every permission check, so they are explicit, not left to EACCES.
+ * A refusal is -EACCES with a message naming the check, the file and its
+ * owner.
+ */
+#define HAL_SHM_DIR "/dev/shm"
+
+static void segment_path(char *buf, size_t n, const char *shm_name)
+{
+    snprintf(buf, n, HAL_SHM_DIR "/%s",
+             shm_name[0] == '/' ? shm_name + 1 : shm_name);
+}
+
+/* "name (uid N)" or "uid N (no user name)" */
+static void owner_words(char *buf, size_t n, uid_t uid)
+{
+    struct passwd pw, *res = NULL;
+    char tmp[1024];
+    if (getpwuid_r(uid, &pw, tmp, sizeof(tmp), &res) == 0 && res)
+        snprintf(buf, n, "%s (uid %u)", res->pw_name, (unsigned)uid);
+    else
+        snprintf(buf, n, "uid %u (no user name)", (unsigned)uid);
+}
+
+static int untrusted(const char *path, uid_t owner, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+static int untrusted(const char *path, uid_t owner, const char *fmt, ...)
+{
+    char why[160], who[160];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(why, sizeof(why), fmt, ap);
+    va_end(ap);
+    owner_words(who, sizeof(who), owner);
+    return hal_fail(EACCES, "refusing HAL segment %s (owner %s): %s; "
+                    "remove it by hand if no HAL of yours uses it", path,
+                    who, why);
+}
+
+/* the checks of an opened segment; 0 or -EACCES with the message */
+static int check_segment(int fd, const char *path)
+{
+    struct stat st;
+    if (fstat(fd, &st) < 0)
+        return hal_fail(errno, "cannot inspect HAL segment %s: %s", path,
+                        strerror(errno));
+    if (!S_ISREG(st.st_mode))
+        return untrusted(path, st.st_uid, "it is not a regular file");
+    if (st.st_uid != geteuid()) {
+        char me[160];
+        owner_words(me, sizeof(me), geteuid());
+        return untrusted(path, st.st_uid, "it is not owned by this user, "
+                         "%s", me);
+    }
+    if ((st.st_mode & 07777) != 0600)
+        return untrusted(path, st.st_uid, "its mode is %04o, not 0600",
+                         (unsigned)(st.st_mode & 07777));
+    if (st.st_nlink != 1)
+        return untrusted(path, st.st_uid, "it has %lu hard links, not 1 "
+                         "(another name shares it)",
+                         (unsigned long)st.st_nlink);
+    return 0;
+}
+
+/*
+ * Open a segment without following a symbolic link and without blocking
+ * (a FIFO planted there), then check it.  The fd, or -errno with the
+ * message: -ENOENT when there is nothing, -EACCES when refused.
+ */
+static int open_segment(const char *shm_name, int flags, char *path,
+                        size_t pathsize)
+{
+    segment_path(path, pathsize, shm_name);
+    int fd = open(path, flags | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC, 0600);
+    if (fd < 0) {
+        int e = errno;
+        struct stat st;
+        if (e != ENOENT && lstat(path, &st) == 0) {
+            if (S_ISLNK(st.st_mode))
+                return untrusted(path, st.st_uid,
+                                 "it is a symbolic link");
+            if (!S_ISREG(st.st_mode))
+                return untrusted(path, st.st_uid,
+                                 "it is not a regular file");
+            if (e == EACCES || e == EPERM)
+                return untrusted(path, st.st_uid, "this user cannot open "
+                                 "it (%s)", strerror(e));
+        }
+        return hal_fail(e, "cannot open HAL segment %s: %s", path,
+                        strerror(e));
+    }
+    int r = check_segment(fd, path);
+    if (r) {
+        close(fd);
+        return r;
+    }
+    return fd;
+}
+
 int hal_instance_create(const char *shm_name, const char *instance,
                         long size)
 {
@@ -1915,11 +2020,25 @@ int hal_instance_create(const char *shm_name, const char *instance,
                         "(%ld .. %ld bytes)", size, HAL_MIN_SIZE,
                         0xF0000000L);
     size = (size + 4095) & ~4095L;
-    int fd = shm_open(shm_name, O_RDWR | O_CREAT | O_EXCL, 0600);
-    if (fd < 0)
-        return hal_fail(errno, "cannot create HAL instance '%s' (%s): %s",
-                        instance, shm_name, strerror(errno));
+    char path[256];
+    segment_path(path, sizeof(path), shm_name);
+    int fd = open(path, O_RDWR | O_CREAT | O_EXCL | O_NOFOLLOW | O_NONBLOCK
+                  | O_CLOEXEC, 0600);
+    if (fd < 0) {
+        int e = errno;
+        struct stat st;
+        if (e == EEXIST && lstat(path, &st) == 0 && st.st_uid != geteuid())
+            return untrusted(path, st.st_uid, "another user's file holds "
+                             "the name of HAL instance '%s'", instance);
+        return hal_fail(e, "cannot create HAL instance '%s' (%s): %s",
+                        instance, path, strerror(e));
+    }
     fchmod(fd, 0600);
+    int tr = check_segment(fd, path);
+    if (tr) {
+        close(fd);
+        return tr;
+    }
     if (ftruncate(fd, size) < 0) {
         int e = errno;
         close(fd);
@@ -1980,16 +2099,17 @@ int hal_instance_create(const char *shm_name, const char *instance,
 int hal_instance_probe(const char *shm_name, int *host_pid,
                        uint64_t *host_start, int *abi)
 {
-    int fd = shm_open(shm_name, O_RDONLY, 0);
+    char path[256];
+    *host_pid = 0;
+    *host_start = 0;
+    *abi = 0;
+    int fd = open_segment(shm_name, O_RDONLY, path, sizeof(path));
     if (fd < 0)
-        return -errno;
+        return fd;
     hal_header_t h;
     memset(&h, 0, sizeof(h));
     ssize_t n = pread(fd, &h, sizeof(h), 0);
     close(fd);
-    *host_pid = 0;
-    *host_start = 0;
-    *abi = 0;
     if (n < (ssize_t)(sizeof(h.magic) + sizeof(h.abi)) || h.magic == 0)
         return -EAGAIN;
     if (h.magic != HAL_MAGIC)
@@ -2009,10 +2129,12 @@ int hal_instance_attach(const char *shm_name)
     if (hal_map.hdr)
         return hal_fail(EBUSY, "this process already uses HAL instance "
                         "'%s'", hal_map.hdr->instance);
-    int fd = shm_open(shm_name, O_RDWR, 0);
+    char path[256];
+    int fd = open_segment(shm_name, O_RDWR, path, sizeof(path));
+    if (fd == -ENOENT)
+        return hal_fail(ENOENT, "no HAL instance at %s", path);
     if (fd < 0)
-        return hal_fail(errno, "no HAL instance at %s: %s", shm_name,
-                        strerror(errno));
+        return fd;
     struct stat st;
     if (fstat(fd, &st) < 0 || st.st_size < (off_t)sizeof(hal_header_t)) {
         close(fd);
