@@ -11,6 +11,7 @@ from typing import Any, Callable, Optional, Union
 
 from halsdk.component import Component
 from halsdk.core import _core, channel, instance
+from halsdk.core.records import Record
 from halsdk.errors import (
     ConflictError,
     InvalidError,
@@ -601,10 +602,36 @@ class Hal:
 
     @staticmethod
     def _list(kind: str, pattern: Union[str, Iterable[str]]) -> list:
+        # the names come with the handles, taken under the lock: an
+        # object deleted meanwhile by another process cannot make the
+        # listing fail (its handle is then stale, as any handle can be)
         pats = [pattern] if isinstance(pattern, str) else list(pattern)
-        found = [it for it in _core.items(kind)
-                 if any(fnmatch.fnmatchcase(it.name, p) for p in pats)]
-        return sorted(found, key=lambda it: it.name)
+        found = [(name, it) for name, it in _core.named_items(kind)
+                 if any(fnmatch.fnmatchcase(name, p) for p in pats)]
+        found.sort(key=lambda pair: pair[0])
+        return [it for _, it in found]
+
+    def snapshot(self, kind: str, pattern: Union[str, Iterable[str]] = "*",
+                 *, sort: bool = True) -> list[Record]:
+        """Records of the objects of a kind whose names match a glob
+        pattern, sorted by name (``sort=False``: in creation order):
+        copies of their metadata and values
+        taken by the core in one pass under the instance lock
+        (:mod:`halsdk.core.records`: ``PinInfo``, ``SignalInfo``, ...).
+
+        Unlike the handles of :meth:`pins` and the like, records never go
+        stale: a snapshot is a consistent picture of the instance at one
+        moment and never fails because another process loads or unloads
+        components meanwhile.  halcmd's ``show``, ``list`` and ``save``
+        print snapshots."""
+        self._check_kind(kind)
+        pats = [pattern] if isinstance(pattern, str) else list(pattern)
+        found = [r for r in _core.snapshot(kind)
+                 if pats == ["*"]
+                 or any(fnmatch.fnmatchcase(r.name, p) for p in pats)]
+        if sort:
+            found.sort(key=lambda r: r.name)
+        return found
 
     def pins(self, pattern: Union[str, Iterable[str]] = "*") -> list:
         """Pins whose names match a glob pattern, sorted by name."""
@@ -762,6 +789,7 @@ class Hal:
             from halsdk.errors import InstanceError
             raise InstanceError(f"HAL instance is inconsistent ({bad} "
                                 f"problems): {report}")
+
 
 
 def check_name(name: str, what: str = "object") -> None:

@@ -20,6 +20,7 @@ import sys
 import traceback
 
 from halsdk.core import errors as _errors
+from halsdk.core import records as _records
 
 cdef extern from "hal_core.h" nogil:
     ctypedef uint32_t hoff_t
@@ -177,6 +178,29 @@ cdef extern from "hal_core.h" nogil:
     int hal_pid_alive(int pid, uint64_t start)
     int hal_lock()
     void hal_unlock()
+    ctypedef struct hal_snap_t:
+        hoff_t off
+        uint32_t gen
+        uint32_t name, owner, link, alias
+        int32_t id, type, dir, flags
+        int32_t ready, pid, users, time, tmax
+        int32_t readers, writers, bidirs
+        uint32_t sub, nsub
+        int64_t period
+        uint64_t pid_start, cycles, overruns
+        uint64_t value
+    ctypedef struct hal_snap_sub_t:
+        uint32_t name
+        int32_t dir
+    ctypedef struct hal_snapshot_t:
+        hal_snap_t *recs
+        long nrecs
+        hal_snap_sub_t *subs
+        long nsubs
+        char *pool
+        long npool
+    int hal_snapshot(int kind, hal_snapshot_t *snap)
+    void hal_snapshot_free(hal_snapshot_t *snap)
     int hal_hold_lock_for_test(double seconds)
     void *hal_find(int kind, const char *name)
     hal_comp_t *hal_comp_by_id(int id)
@@ -1122,6 +1146,89 @@ def items(str kind):
     finally:
         hal_unlock()
     return out
+
+
+def named_items(str kind):
+    """``(name, handle)`` of every object of a kind, in creation order;
+    the names are taken under the lock with the handles, so sorting or
+    filtering by them never fails when an object goes meanwhile."""
+    return [((<Item>it)._name, it) for it in items(kind)]
+
+
+cdef str _pool_str(hal_snapshot_t *s, uint32_t at):
+    return (s.pool + at).decode("utf-8", "replace")
+
+
+cdef object _pool_opt(hal_snapshot_t *s, uint32_t at):
+    return (s.pool + at).decode("utf-8", "replace") if at else None
+
+
+cdef list _records_of(int k, hal_snapshot_t *s):
+    cdef long i
+    cdef uint32_t j
+    cdef hal_snap_t *r
+    cdef hal_snap_sub_t *sub
+    out = []
+    for i in range(s.nrecs):
+        r = &s.recs[i]
+        name = _pool_str(s, r.name)
+        if k == K_PIN:
+            out.append(_records.PinInfo(
+                name, r.type, r.dir, get_raw(r.type, &r.value),
+                _pool_str(s, r.owner), r.id, _pool_opt(s, r.link),
+                _pool_opt(s, r.alias)))
+        elif k == K_PARAM:
+            out.append(_records.ParamInfo(
+                name, r.type, r.dir, get_raw(r.type, &r.value),
+                _pool_str(s, r.owner), r.id, _pool_opt(s, r.alias)))
+        elif k == K_SIG:
+            pins = []
+            for j in range(r.nsub):
+                sub = &s.subs[r.sub + j]
+                pins.append(_records.LinkedPin(_pool_str(s, sub.name),
+                                               sub.dir))
+            out.append(_records.SignalInfo(
+                name, r.type, get_raw(r.type, &r.value), tuple(pins),
+                r.readers, r.writers, r.bidirs))
+        elif k == K_COMP:
+            out.append(_records.ComponentInfo(
+                name, r.id, r.flags & 1 != 0, r.ready != 0, r.pid,
+                hal_pid_alive(r.pid, r.pid_start) != 0))
+        elif k == K_INST:
+            out.append(_records.InstanceInfo(name, r.id,
+                                             _pool_str(s, r.owner)))
+        elif k == K_FUNCT:
+            out.append(_records.FunctionInfo(
+                name, _pool_str(s, r.owner), r.id, r.flags & 1 != 0,
+                r.flags & 2 != 0, r.users, r.flags & 4 == 0, r.time,
+                r.tmax))
+        elif k == K_THREAD:
+            out.append(_records.ThreadInfo(
+                name, r.period, r.flags & 1 != 0, r.flags & 2 != 0,
+                tuple(_pool_str(s, s.subs[r.sub + j].name)
+                      for j in range(r.nsub)),
+                r.time, r.tmax, r.cycles, r.overruns))
+        else:
+            out.append(_records.StreamInfo(name, _pool_str(s, r.owner)))
+    return out
+
+
+def snapshot(str kind):
+    """Records (:mod:`halsdk.core.records`) of every object of a kind, in
+    creation order: names, metadata and values copied by the core in one
+    pass under the lock, so a listing never fails or mixes states when
+    another process changes the instance meanwhile."""
+    need_instance()
+    cdef int k = _KIND_BY_WORD[kind]
+    cdef hal_snapshot_t s
+    cdef int r
+    with nogil:
+        r = hal_snapshot(k, &s)
+    check(r)
+    try:
+        return _records_of(k, &s)
+    finally:
+        hal_snapshot_free(&s)
 
 
 def comp_by_id(int id):

@@ -310,8 +310,8 @@ class CommandRunner:
         for kind in _CREATED_KINDS:
             added = after[kind] - before[kind]
             if added > 0:
-                self.created(kind, [it.name for it
-                                    in self.hal.items(kind)[-added:]])
+                self.created(kind, [it.name for it in self.hal.snapshot(
+                    kind, sort=False)[-added:]])
 
     def _locked(self, bit: int) -> bool:
         return bool(self.hal.lock_level & bit)
@@ -384,7 +384,7 @@ class CommandRunner:
                 self.register()
 
     def _rt_modules(self) -> set[str]:
-        return {c.name for c in self.hal.items("component")
+        return {c.name for c in self.hal.snapshot("component", sort=False)
                 if c.realtime and not c.name.startswith("__")}
 
     def cmd_newinst(self, args: list[str]) -> None:
@@ -471,7 +471,8 @@ class CommandRunner:
             # never this process (halcmd would end itself with SIGTERM)
             # nor another halcmd session, as in the reference
             me = os.getpid()
-            names = [c.name for c in self.hal.items("component")
+            names = [c.name
+                     for c in self.hal.snapshot("component", sort=False)
                      if not c.realtime and c.id != self.comp_id
                      and c.pid != me and not is_halcmd_comp(c.name, c.pid)
                      and not c.name.startswith("__")]

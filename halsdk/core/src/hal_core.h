@@ -403,6 +403,45 @@ void *hal_symbol_find(const char *name, const char *user);
 void hal_symbol_drop(const char *module);
 const char *hal_symbol_user(const char *module);
 
+/*
+ * Listings (hal_snapshot.c): every object of a kind copied in one pass
+ * under the lock.  Strings are offsets into pool (0: none / empty); the
+ * pins of a signal and the functions of a thread are subs[sub ..
+ * sub + nsub - 1].  Per kind: id is the component or instance id (pins,
+ * params, functions: the owner's id); flags: component 1 realtime;
+ * function 1 uses_fp, 2 reentrant, 4 Python; thread 1 uses_fp, 2 running.
+ */
+typedef struct {
+    hoff_t off;
+    uint32_t gen;
+    uint32_t name, owner, link, alias;  /* link: a pin's signal; alias:
+                                           the original name */
+    int32_t id, type, dir, flags;
+    int32_t ready, pid, users, time, tmax;
+    int32_t readers, writers, bidirs;
+    uint32_t sub, nsub;
+    int64_t period;
+    uint64_t pid_start, cycles, overruns;
+    uint64_t value;                     /* the value's bytes */
+} hal_snap_t;
+
+typedef struct {
+    uint32_t name;
+    int32_t dir;
+} hal_snap_sub_t;
+
+typedef struct {
+    hal_snap_t *recs;
+    long nrecs, caprecs;
+    hal_snap_sub_t *subs;
+    long nsubs, capsubs;
+    char *pool;
+    long npool, cappool;
+} hal_snapshot_t;
+
+int hal_snapshot(int kind, hal_snapshot_t *snap);   /* takes the lock */
+void hal_snapshot_free(hal_snapshot_t *snap);
+
 /* values */
 hal_value_t *hal_pin_value(hal_pin_t *pin);
 void *hal_param_value(hal_param_t *param);
