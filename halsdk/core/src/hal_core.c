@@ -1770,6 +1770,27 @@ int hal_set_lock(unsigned char lock)
 /* ---------------------------------------------------------------- */
 /* consistency                                                      */
 
+/* add a problem to the report: "; " between problems, "..." once full */
+static void note(char *rep, int len, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+static void note(char *rep, int len, const char *fmt, ...)
+{
+    int used = (int)strlen(rep);
+    if (used >= len - 4)
+        return;
+    if (used) {
+        snprintf(rep + used, len - used, "; ");
+        used += 2;
+    }
+    va_list ap;
+    va_start(ap, fmt);
+    int n = vsnprintf(rep + used, len - used, fmt, ap);
+    va_end(ap);
+    if (n >= len - used)
+        snprintf(rep + len - 4, 4, "...");
+}
+
 static int fsck_kind(int kind, char *rep, int len, int *bad)
 {
     hal_header_t *h = hal_map.hdr;
@@ -1778,13 +1799,13 @@ static int fsck_kind(int kind, char *rep, int len, int *bad)
     for (hoff_t o = h->list_head[kind]; o;) {
         hal_obj_t *obj = SHMPTR(o);
         if (o >= h->heap_top || obj->kind != kind || obj->prev != prev) {
-            snprintf(rep, len, "%s list broken at offset %u",
+            note(rep, len, "%s list broken at offset %u",
                      kind_word(kind), o);
             (*bad)++;
             return n;
         }
         if (find_in_space(name_space(kind), obj->name) != obj) {
-            snprintf(rep, len, "%s '%s' is not in the name index",
+            note(rep, len, "%s '%s' is not in the name index",
                      kind_word(kind), obj->name);
             (*bad)++;
         }
@@ -1793,63 +1814,170 @@ static int fsck_kind(int kind, char *rep, int len, int *bad)
         o = obj->next;
     }
     if (n != h->count[kind] || prev != h->list_tail[kind]) {
-        snprintf(rep, len, "%s count %d but %d listed", kind_word(kind),
+        note(rep, len, "%s count %d but %d listed", kind_word(kind),
                  h->count[kind], n);
         (*bad)++;
     }
     return n;
 }
 
-/* check the invariants; returns 0 when consistent */
+/* sorted offsets: the index of off, or -1 */
+static int cmp_hoff(const void *a, const void *b)
+{
+    hoff_t x = *(const hoff_t *)a, y = *(const hoff_t *)b;
+    return x < y ? -1 : x > y;
+}
+
+static long index_of_off(const hoff_t *offs, long n, hoff_t off)
+{
+    long lo = 0, hi = n - 1;
+    while (lo <= hi) {
+        long mid = lo + (hi - lo) / 2;
+        if (offs[mid] == off)
+            return mid;
+        if (offs[mid] < off)
+            lo = mid + 1;
+        else
+            hi = mid - 1;
+    }
+    return -1;
+}
+
+/* the offsets of the first n objects of a kind's list, sorted */
+static hoff_t *sorted_offsets(int kind, long n)
+{
+    hoff_t *offs = malloc((n ? n : 1) * sizeof(hoff_t));
+    if (!offs)
+        return NULL;
+    long k = 0;
+    for (hoff_t o = hal_map.hdr->list_head[kind]; o && k < n;
+         o = ((hal_obj_t *)SHMPTR(o))->next)
+        offs[k++] = o;
+    qsort(offs, k, sizeof(hoff_t), cmp_hoff);
+    return offs;
+}
+
+/* an offset of a record of size bytes inside the heap */
+static int in_heap(hoff_t off, size_t size)
+{
+    hal_header_t *h = hal_map.hdr;
+    return off >= h->heap_start && (uint64_t)off + size <= h->heap_top;
+}
+
+/*
+ * Check the invariants; returns the number of problems (0: consistent)
+ * and them in rep ("; " between them, cut with "..." when long), or -errno when it cannot check (the lock
+ * timed out, no memory).  One pass over each
+ * list plus a sort of the signal and function offsets: O(n log n), so
+ * the lock is held briefly even for a large instance (the old pairwise
+ * pin x signal and function x thread loops were quadratic).
+ */
 int hal_check_consistency(char *rep, int len)
 {
     int bad = 0;
     rep[0] = 0;
-    if (hal_lock())
-        return -1;
+    int r = hal_lock();
+    if (r)
+        return r;
+    int n[K_NKINDS] = {0};
     for (int k = 1; k < K_NKINDS; k++)
-        fsck_kind(k, rep, len, &bad);
+        n[k] = fsck_kind(k, rep, len, &bad);
+    hoff_t *sigs = sorted_offsets(K_SIG, n[K_SIG]);
+    hoff_t *functs = sorted_offsets(K_FUNCT, n[K_FUNCT]);
+    int32_t *cnt = calloc(3 * (size_t)(n[K_SIG] ? n[K_SIG] : 1),
+                          sizeof(int32_t));
+    int32_t *users = calloc(n[K_FUNCT] ? n[K_FUNCT] : 1, sizeof(int32_t));
+    if (!sigs || !functs || !cnt || !users) {
+        hal_unlock();
+        free(sigs);
+        free(functs);
+        free(cnt);
+        free(users);
+        return hal_fail(ENOMEM, "out of memory while checking HAL "
+                        "instance '%s'", hal_map.hdr->instance);
+    }
+    /* links: count each signal's pins by direction */
+    long np = 0;
+    FOR_EACH(K_PIN, hal_pin_t, p) {
+        if (np++ >= n[K_PIN])
+            break;
+        long i = p->signal ? index_of_off(sigs, n[K_SIG], p->signal) : -1;
+        if (i >= 0) {
+            cnt[3 * i] += p->dir == HALSDK_IN;
+            cnt[3 * i + 1] += p->dir == HALSDK_OUT;
+            cnt[3 * i + 2] += p->dir == HALSDK_IO;
+        }
+    }
+    long ns = 0;
     FOR_EACH(K_SIG, hal_sig_t, s) {
-        int rd = 0, wr = 0, io = 0;
-        hoff_t so = SHMOFF(s);
-        FOR_EACH(K_PIN, hal_pin_t, p)
-            if (p->signal == so) {
-                rd += p->dir == HALSDK_IN;
-                wr += p->dir == HALSDK_OUT;
-                io += p->dir == HALSDK_IO;
-            }
+        if (ns >= n[K_SIG])
+            break;
+        long i = index_of_off(sigs, n[K_SIG], SHMOFF(s));
+        int rd = cnt[3 * i], wr = cnt[3 * i + 1], io = cnt[3 * i + 2];
+        ns++;
         if (rd != s->readers || wr != s->writers || io != s->bidirs ||
             wr > 1 || (wr && io)) {
-            snprintf(rep, len, "signal '%s' link counts are wrong",
+            note(rep, len, "signal '%s' link counts are wrong",
                      s->o.name);
             bad++;
         }
     }
+    np = 0;
     FOR_EACH(K_PIN, hal_pin_t, p) {
-        hal_obj_t *c = SHMPTR(p->comp);
-        if (c->kind != K_COMP) {
-            snprintf(rep, len, "pin '%s' has no owner", p->o.name);
+        if (np++ >= n[K_PIN])
+            break;
+        if (!in_heap(p->comp, sizeof(hal_obj_t)) ||
+            ((hal_obj_t *)SHMPTR(p->comp))->kind != K_COMP) {
+            note(rep, len, "pin '%s' has no owner", p->o.name);
             bad++;
         }
-        if (p->signal && ((hal_obj_t *)SHMPTR(p->signal))->kind != K_SIG) {
-            snprintf(rep, len, "pin '%s' is linked to a deleted signal",
+        if (p->signal && index_of_off(sigs, n[K_SIG], p->signal) < 0) {
+            note(rep, len, "pin '%s' is linked to a deleted signal",
                      p->o.name);
             bad++;
         }
     }
+    /* thread entries: count each function's users */
+    long nt = 0;
+    FOR_EACH(K_THREAD, hal_thread_t, t) {
+        if (nt++ >= n[K_THREAD])
+            break;
+        long guard = 0;
+        for (hoff_t e = t->functs; e && guard++ <= n[K_FUNCT] * 64L + 64;
+             e = ((hal_fentry_t *)SHMPTR(e))->next) {
+            if (!in_heap(e, sizeof(hal_fentry_t))) {
+                note(rep, len, "thread '%s' function list is broken",
+                         t->o.name);
+                bad++;
+                break;
+            }
+            long i = index_of_off(functs, n[K_FUNCT],
+                                  ((hal_fentry_t *)SHMPTR(e))->funct);
+            if (i >= 0)
+                users[i]++;
+            else {
+                note(rep, len, "thread '%s' calls a deleted function",
+                         t->o.name);
+                bad++;
+            }
+        }
+    }
+    long nf = 0;
     FOR_EACH(K_FUNCT, hal_funct_t, f) {
-        int users = 0;
-        FOR_EACH(K_THREAD, hal_thread_t, t)
-            for (hoff_t e = t->functs; e;
-                 e = ((hal_fentry_t *)SHMPTR(e))->next)
-                users += ((hal_fentry_t *)SHMPTR(e))->funct == SHMOFF(f);
-        if (users != f->users) {
-            snprintf(rep, len, "function '%s' has %d users, %d counted",
-                     f->o.name, f->users, users);
+        if (nf++ >= n[K_FUNCT])
+            break;
+        long i = index_of_off(functs, n[K_FUNCT], SHMOFF(f));
+        if (users[i] != f->users) {
+            note(rep, len, "function '%s' has %d users, %d counted",
+                     f->o.name, f->users, users[i]);
             bad++;
         }
     }
     hal_unlock();
+    free(sigs);
+    free(functs);
+    free(cnt);
+    free(users);
     return bad;
 }
 
