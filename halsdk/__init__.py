@@ -30,6 +30,7 @@ from halsdk.errors import (
                            InstanceError,
                            InvalidError,
                            LoadError,
+                           LockTimeoutError,
                            NotFoundError,
                            NotPermittedError,
                            Rule,
@@ -63,5 +64,5 @@ __all__ = [
     "RW", "NAME_LEN", "REFERENCE_NAME_LEN",
     "HalError", "NotFoundError", "ExistsError", "HalTypeError",
     "ConflictError", "NotPermittedError", "InvalidError", "CapacityError",
-    "InstanceError", "StaleError", "LoadError",
+    "InstanceError", "StaleError", "LoadError", "LockTimeoutError",
 ]

@@ -794,6 +794,18 @@ class Hal:
             raise InstanceError(f"HAL instance '{self.instance}' is "
                                 f"inconsistent ({bad} problems): {report}")
 
+    @property
+    def lock_timeout(self) -> float:
+        """Seconds this process waits for the instance lock before the
+        operation fails with :class:`~halsdk.errors.LockTimeoutError`
+        naming the holder's pid (default 5 s, or ``$HALSDK_LOCK_TIMEOUT``
+        when the process starts); settable, for the whole process."""
+        return _core.lock_timeout()
+
+    @lock_timeout.setter
+    def lock_timeout(self, seconds: float) -> None:
+        _core.set_lock_timeout(seconds)
+
 
 def check_name(name: str, what: str = "object") -> None:
     """Raise :class:`~halsdk.InvalidError` (rule ``BAD_NAME``) if the core

@@ -148,6 +148,7 @@ cdef extern from "hal_core.h" nogil:
         int64_t sim_time
         int32_t threads_running
         int32_t recovered
+        int32_t lock_holder
 
     ctypedef struct hal_map_t:
         char *base
@@ -178,6 +179,8 @@ cdef extern from "hal_core.h" nogil:
     int hal_pid_alive(int pid, uint64_t start)
     int hal_lock()
     void hal_unlock()
+    double hal_lock_timeout()
+    int hal_set_lock_timeout(double seconds)
     ctypedef struct hal_snap_t:
         hoff_t off
         uint32_t gen
@@ -1071,6 +1074,7 @@ def info() -> dict:
         "threads_running": h.threads_running != 0,
         "recovered": h.recovered,
         "msg_level": h.msg_level,
+        "lock_holder": h.lock_holder,
     }
 
 
@@ -1230,6 +1234,22 @@ def snapshot(str kind):
         return _records_of(k, &s)
     finally:
         hal_snapshot_free(&s)
+
+
+def lock_timeout() -> float:
+    """Seconds a wait for the instance lock lasts before it fails."""
+    return hal_lock_timeout()
+
+
+def set_lock_timeout(double seconds):
+    """Set this process's lock timeout (more than 0, at most 86400 s)."""
+    check(hal_set_lock_timeout(seconds))
+
+
+def lock_holder() -> int:
+    """The pid holding the instance lock now, 0 when none."""
+    need_instance()
+    return hal_map.hdr.lock_holder
 
 
 def _test_offset(str kind, name) -> int:

@@ -103,6 +103,12 @@ class InstanceError(HalError):
     """No instance, an incompatible one (ABI version), or a dead host."""
 
 
+class LockTimeoutError(InstanceError, TimeoutError):
+    """The instance lock could not be taken within the lock timeout
+    (``HALSDK_LOCK_TIMEOUT``, default 5 s): the message names the
+    instance and the pid holding the lock (a stopped or stuck process)."""
+
+
 class StaleError(HalError):
     """A handle whose object has been deleted."""
 
@@ -124,6 +130,7 @@ ERRNO_CLASS: dict[int, Callable[..., HalError]] = {
     22: InvalidError,           # EINVAL
     71: InstanceError,          # EPROTO
     19: InstanceError,          # ENODEV
+    110: LockTimeoutError,      # ETIMEDOUT
 }
 
 
@@ -142,6 +149,7 @@ __all__ = [
     "InstanceError",
     "InvalidError",
     "LoadError",
+    "LockTimeoutError",
     "NotFoundError",
     "NotPermittedError",
     "Rule",

@@ -19,7 +19,7 @@ from typing import Callable, Optional
 from halsdk import console
 from halsdk.compat import program_env
 from halsdk.component import Component
-from halsdk.errors import HalError, Rule
+from halsdk.errors import HalError, LockTimeoutError, Rule
 from halsdk.hal import Hal, is_halcmd_comp
 from halsdk.halcmd.helptext import HELP
 from halsdk.halcmd.lexer import (
@@ -254,6 +254,11 @@ class CommandRunner:
                 raise hal_error(str(exc), f"{words[0]} failed") from None
         except CommandError as exc:
             self.errors += 1
+            if isinstance(exc.__context__, LockTimeoutError):
+                # the instance failed, not the command (its host died, a
+                # stopped process holds the lock): one line that says so
+                self.error(str(exc.__context__))
+                return False
             if self.verbose >= 0:
                 for line in exc.lines:
                     self.err(line + "\n")

@@ -192,17 +192,107 @@ static void recover_after_dead_holder(void);
 void *(*hal_gil_release)(void);
 void (*hal_gil_restore)(void *);
 
+/*
+ * How long hal_lock() waits: $HALSDK_LOCK_TIMEOUT (seconds, read on first
+ * use; a value that is not a positive number is ignored) or
+ * HAL_LOCK_TIMEOUT, until hal_set_lock_timeout() sets it for the process.
+ */
+static double lock_timeout_s = -1.0;
+
+double hal_lock_timeout(void)
+{
+    if (lock_timeout_s < 0) {
+        const char *env = getenv("HALSDK_LOCK_TIMEOUT");
+        char *end = NULL;
+        double v = env && *env ? strtod(env, &end) : 0.0;
+        lock_timeout_s = (env && *env && end && *end == 0 && v > 0
+                          && v <= 86400.0) ? v : HAL_LOCK_TIMEOUT;
+    }
+    return lock_timeout_s;
+}
+
+int hal_set_lock_timeout(double seconds)
+{
+    if (!(seconds > 0 && seconds <= 86400.0))
+        return hal_fail(EINVAL, "lock timeout %g s is out of range "
+                        "(more than 0, at most 86400 s)", seconds);
+    lock_timeout_s = seconds;
+    return 0;
+}
+
+/* the command name and state letter of a process, from /proc/pid/stat */
+static int proc_name_state(int pid, char *comm, int len, char *state)
+{
+    char path[64], buf[512];
+    comm[0] = 0;
+    *state = 0;
+    if (pid <= 0)
+        return -1;
+    snprintf(path, sizeof(path), "/proc/%d/stat", pid);
+    int fd = open(path, O_RDONLY);
+    if (fd < 0)
+        return -1;
+    ssize_t n = read(fd, buf, sizeof(buf) - 1);
+    close(fd);
+    if (n <= 0)
+        return -1;
+    buf[n] = 0;
+    char *open_paren = strchr(buf, '(');
+    char *close_paren = strrchr(buf, ')');
+    if (!open_paren || !close_paren || close_paren < open_paren)
+        return -1;
+    int clen = (int)(close_paren - open_paren - 1);
+    if (clen >= len)
+        clen = len - 1;
+    memcpy(comm, open_paren + 1, clen);
+    comm[clen] = 0;
+    if (close_paren[1] == ' ')
+        *state = close_paren[2];
+    return 0;
+}
+
+/* the failure of a wait for the lock that timed out: name the holder */
+static int fail_lock_timeout(hal_header_t *h, double waited)
+{
+    int pid = __atomic_load_n(&h->lock_holder, __ATOMIC_RELAXED);
+    char comm[32], state;
+    if (pid <= 0)
+        return hal_fail(ETIMEDOUT, "HAL instance '%s': instance lock held "
+                        "by an unknown process (stopped?) for more than "
+                        "%g s; gave up", h->instance, waited);
+    if (proc_name_state(pid, comm, sizeof(comm), &state) < 0)
+        return hal_fail(ETIMEDOUT, "HAL instance '%s': instance lock held "
+                        "by pid %d (stopped?) for more than %g s; gave up",
+                        h->instance, pid, waited);
+    return hal_fail(ETIMEDOUT, "HAL instance '%s': instance lock held by "
+                    "pid %d (%s) for more than %g s; gave up (process "
+                    "'%s', state %c)", h->instance, pid,
+                    state == 'T' || state == 't' ? "stopped" : "stopped?",
+                    waited, comm, state ? state : '?');
+}
+
 int hal_lock(void)
 {
     hal_header_t *h = hal_map.hdr;
     if (!h)
         return hal_fail(ENODEV, "no HAL instance is attached");
     /* A holder may be waiting for a thread cycle that runs a Python
-       function: never wait for the mutex with the GIL held. */
+       function: never wait for the mutex with the GIL held.  A holder
+       that is stopped (SIGSTOP) or stuck must not block this process for
+       ever: wait at most the lock timeout. */
     int r = pthread_mutex_trylock(&h->mutex);
+    double waited = 0;
     if (r == EBUSY) {
+        waited = hal_lock_timeout();
+        struct timespec until;
+        clock_gettime(CLOCK_MONOTONIC, &until);
+        long long ns = (long long)(waited * 1e9) + until.tv_nsec;
+        until.tv_sec += ns / 1000000000LL;
+        until.tv_nsec = ns % 1000000000LL;
         void *gil = hal_gil_release ? hal_gil_release() : NULL;
-        r = pthread_mutex_lock(&h->mutex);
+        do
+            r = pthread_mutex_clocklock(&h->mutex, CLOCK_MONOTONIC, &until);
+        while (r == EINTR);
         if (gil)
             hal_gil_restore(gil);
     }
@@ -210,17 +300,23 @@ int hal_lock(void)
         recover_after_dead_holder();
         pthread_mutex_consistent(&h->mutex);
         h->recovered++;
-        return 0;
+        r = 0;
     }
+    if (r == ETIMEDOUT)
+        return fail_lock_timeout(h, waited);
     if (r)
-        return hal_fail(r, "cannot lock the HAL instance: %s", strerror(r));
+        return hal_fail(r, "cannot lock HAL instance '%s': %s", h->instance,
+                        strerror(r));
+    __atomic_store_n(&h->lock_holder, (int32_t)getpid(), __ATOMIC_RELAXED);
     return 0;
 }
 
 void hal_unlock(void)
 {
-    if (hal_map.hdr)
+    if (hal_map.hdr) {
+        __atomic_store_n(&hal_map.hdr->lock_holder, 0, __ATOMIC_RELAXED);
         pthread_mutex_unlock(&hal_map.hdr->mutex);
+    }
 }
 
 /* test hook: hold the lock so that a test can kill the holder */

@@ -20,7 +20,7 @@
 #include <sys/types.h>
 
 #define HAL_MAGIC 0x31304b4453474c48ULL   /* "HLGSDK01" */
-#define HAL_ABI_VERSION 3
+#define HAL_ABI_VERSION 4
 #define HAL_NAME_SIZE (HALSDK_NAME_LEN + 1)
 #define HAL_DEFAULT_SIZE (160L * 1024 * 1024)
 #define HAL_MIN_SIZE (1L * 1024 * 1024)
@@ -225,6 +225,7 @@ typedef struct {
     int32_t threads_running;
     int32_t recovered;          /* times a dead lock holder was cleaned up */
     int32_t naliases;           /* pins and params that have an alias */
+    int32_t lock_holder;        /* pid holding the mutex, 0: none (ABI 4) */
 } hal_header_t;
 
 /* a mapping of an instance in this process */
@@ -297,8 +298,13 @@ int hal_instance_probe(const char *shm_name, int *host_pid,
 uint64_t hal_proc_start_time(int pid);
 int hal_pid_alive(int pid, uint64_t start);
 
-/* mutex */
+/* mutex: hal_lock() waits at most hal_lock_timeout() seconds (default
+   HAL_LOCK_TIMEOUT, or $HALSDK_LOCK_TIMEOUT), then fails with ETIMEDOUT
+   naming the holder.  The realtime threads never take it. */
+#define HAL_LOCK_TIMEOUT 5.0
 int hal_lock(void);
+double hal_lock_timeout(void);
+int hal_set_lock_timeout(double seconds);
 /* set by the Python binding: drop and retake the GIL around a wait */
 extern void *(*hal_gil_release)(void);
 extern void (*hal_gil_restore)(void *);
