@@ -27,6 +27,7 @@ from halsdk.errors import (
                            ExistsError,
                            HalError,
                            HalTypeError,
+                           HostGoneError,
                            InstanceError,
                            InvalidError,
                            LoadError,
@@ -65,4 +66,5 @@ __all__ = [
     "HalError", "NotFoundError", "ExistsError", "HalTypeError",
     "ConflictError", "NotPermittedError", "InvalidError", "CapacityError",
     "InstanceError", "StaleError", "LoadError", "LockTimeoutError",
+    "HostGoneError",
 ]

@@ -109,6 +109,12 @@ class LockTimeoutError(InstanceError, TimeoutError):
     instance and the pid holding the lock (a stopped or stuck process)."""
 
 
+class HostGoneError(InstanceError, ConnectionError):
+    """The host of the instance cannot be reached or went away during a
+    request (refused, reset or closed channel, no answer in time); the
+    message names the instance."""
+
+
 class StaleError(HalError):
     """A handle whose object has been deleted."""
 
@@ -146,6 +152,7 @@ __all__ = [
     "ExistsError",
     "HalError",
     "HalTypeError",
+    "HostGoneError",
     "InstanceError",
     "InvalidError",
     "LoadError",

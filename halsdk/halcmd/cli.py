@@ -270,6 +270,7 @@ def _halcmd_main(argv: Optional[list[str]] = None) -> int:
     from halsdk import Hal
     from halsdk.errors import (
         HalError,
+        HostGoneError,
         InvalidError,
         LockTimeoutError,
     )
@@ -283,7 +284,7 @@ def _halcmd_main(argv: Optional[list[str]] = None) -> int:
         return _check(opts, "halcmd")
     try:
         hal = Hal(create=False)
-    except (InvalidError, LockTimeoutError) as exc:
+    except (InvalidError, LockTimeoutError, HostGoneError) as exc:
         print(f"halcmd: {exc}", file=sys.stderr)
         return 1
     except HalError as exc:

@@ -19,7 +19,7 @@ from typing import Callable, Optional
 from halsdk import console
 from halsdk.compat import program_env
 from halsdk.component import Component
-from halsdk.errors import HalError, LockTimeoutError, Rule
+from halsdk.errors import HalError, HostGoneError, LockTimeoutError, Rule
 from halsdk.hal import Hal, is_halcmd_comp
 from halsdk.halcmd.helptext import HELP
 from halsdk.halcmd.lexer import (
@@ -254,7 +254,7 @@ class CommandRunner:
                 raise hal_error(str(exc), f"{words[0]} failed") from None
         except CommandError as exc:
             self.errors += 1
-            if isinstance(exc.__context__, LockTimeoutError):
+            if isinstance(exc.__context__, (HostGoneError, LockTimeoutError)):
                 # the instance failed, not the command (its host died, a
                 # stopped process holds the lock): one line that says so
                 self.error(str(exc.__context__))
