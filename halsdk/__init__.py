@@ -27,9 +27,11 @@ from halsdk.errors import (
                            ExistsError,
                            HalError,
                            HalTypeError,
+                           HostGoneError,
                            InstanceError,
                            InvalidError,
                            LoadError,
+                           LockTimeoutError,
                            NotFoundError,
                            NotPermittedError,
                            Rule,
@@ -65,4 +67,5 @@ __all__ = [
     "HalError", "NotFoundError", "ExistsError", "HalTypeError",
     "ConflictError", "NotPermittedError", "InvalidError", "CapacityError",
     "InstanceError", "StaleError", "LoadError", "TrustError",
+    "LockTimeoutError", "HostGoneError",
 ]

@@ -11,6 +11,7 @@ from typing import Any, Callable, Optional, Union
 
 from halsdk.component import Component
 from halsdk.core import _core, channel, instance
+from halsdk.core.records import Record
 from halsdk.errors import (
     ConflictError,
     InvalidError,
@@ -603,10 +604,36 @@ class Hal:
 
     @staticmethod
     def _list(kind: str, pattern: Union[str, Iterable[str]]) -> list:
+        # the names come with the handles, taken under the lock: an
+        # object deleted meanwhile by another process cannot make the
+        # listing fail (its handle is then stale, as any handle can be)
         pats = [pattern] if isinstance(pattern, str) else list(pattern)
-        found = [it for it in _core.items(kind)
-                 if any(fnmatch.fnmatchcase(it.name, p) for p in pats)]
-        return sorted(found, key=lambda it: it.name)
+        found = [(name, it) for name, it in _core.named_items(kind)
+                 if any(fnmatch.fnmatchcase(name, p) for p in pats)]
+        found.sort(key=lambda pair: pair[0])
+        return [it for _, it in found]
+
+    def snapshot(self, kind: str, pattern: Union[str, Iterable[str]] = "*",
+                 *, sort: bool = True) -> list[Record]:
+        """Records of the objects of a kind whose names match a glob
+        pattern, sorted by name (``sort=False``: in creation order):
+        copies of their metadata and values
+        taken by the core in one pass under the instance lock
+        (:mod:`halsdk.core.records`: ``PinInfo``, ``SignalInfo``, ...).
+
+        Unlike the handles of :meth:`pins` and the like, records never go
+        stale: a snapshot is a consistent picture of the instance at one
+        moment and never fails because another process loads or unloads
+        components meanwhile.  halcmd's ``show``, ``list`` and ``save``
+        print snapshots."""
+        self._check_kind(kind)
+        pats = [pattern] if isinstance(pattern, str) else list(pattern)
+        found = [r for r in _core.snapshot(kind)
+                 if pats == ["*"]
+                 or any(fnmatch.fnmatchcase(r.name, p) for p in pats)]
+        if sort:
+            found.sort(key=lambda r: r.name)
+        return found
 
     def pins(self, pattern: Union[str, Iterable[str]] = "*") -> list:
         """Pins whose names match a glob pattern, sorted by name."""
@@ -758,12 +785,28 @@ class Hal:
         return "".join(out)
 
     def check(self) -> None:
-        """Verify the instance's invariants; raise if any is broken."""
+        """Verify the instance's invariants; raise if any is broken.
+
+        The lists, counts, name index, signal link counts, pin owners and
+        links, and function users are checked in O(n log n) under the
+        instance lock (well under a second at 125,000 pins)."""
         bad, report = _core.check_consistency()
         if bad:
             from halsdk.errors import InstanceError
-            raise InstanceError(f"HAL instance is inconsistent ({bad} "
-                                f"problems): {report}")
+            raise InstanceError(f"HAL instance '{self.instance}' is "
+                                f"inconsistent ({bad} problems): {report}")
+
+    @property
+    def lock_timeout(self) -> float:
+        """Seconds this process waits for the instance lock before the
+        operation fails with :class:`~halsdk.errors.LockTimeoutError`
+        naming the holder's pid (default 5 s, or ``$HALSDK_LOCK_TIMEOUT``
+        when the process starts); settable, for the whole process."""
+        return _core.lock_timeout()
+
+    @lock_timeout.setter
+    def lock_timeout(self, seconds: float) -> None:
+        _core.set_lock_timeout(seconds)
 
 
 def check_name(name: str, what: str = "object") -> None:

@@ -934,7 +934,10 @@ def pin_has_writer(name: str, /) -> bool:
 
 
 def _sorted(kind: str) -> list:
-    return sorted(_need_instance().items(kind), key=lambda it: it.name)
+    """Records of every object of a kind, by name: a snapshot taken in
+    one pass, which never fails while other processes load or unload
+    components."""
+    return _need_instance().snapshot(kind)
 
 
 def get_info_pins() -> list[dict[str, Any]]:

@@ -20,6 +20,7 @@ import sys
 import traceback
 
 from halsdk.core import errors as _errors
+from halsdk.core import records as _records
 
 cdef extern from "hal_core.h" nogil:
     ctypedef uint32_t hoff_t
@@ -147,6 +148,7 @@ cdef extern from "hal_core.h" nogil:
         int64_t sim_time
         int32_t threads_running
         int32_t recovered
+        int32_t lock_holder
 
     ctypedef struct hal_map_t:
         char *base
@@ -177,6 +179,31 @@ cdef extern from "hal_core.h" nogil:
     int hal_pid_alive(int pid, uint64_t start)
     int hal_lock()
     void hal_unlock()
+    double hal_lock_timeout()
+    int hal_set_lock_timeout(double seconds)
+    ctypedef struct hal_snap_t:
+        hoff_t off
+        uint32_t gen
+        uint32_t name, owner, link, alias
+        int32_t id, type, dir, flags
+        int32_t ready, pid, users, time, tmax
+        int32_t readers, writers, bidirs
+        uint32_t sub, nsub
+        int64_t period
+        uint64_t pid_start, cycles, overruns
+        uint64_t value
+    ctypedef struct hal_snap_sub_t:
+        uint32_t name
+        int32_t dir
+    ctypedef struct hal_snapshot_t:
+        hal_snap_t *recs
+        long nrecs
+        hal_snap_sub_t *subs
+        long nsubs
+        char *pool
+        long npool
+    int hal_snapshot(int kind, hal_snapshot_t *snap)
+    void hal_snapshot_free(hal_snapshot_t *snap)
     int hal_hold_lock_for_test(double seconds)
     void *hal_find(int kind, const char *name)
     hal_comp_t *hal_comp_by_id(int id)
@@ -1051,6 +1078,7 @@ def info() -> dict:
         "threads_running": h.threads_running != 0,
         "recovered": h.recovered,
         "msg_level": h.msg_level,
+        "lock_holder": h.lock_holder,
     }
 
 
@@ -1081,12 +1109,13 @@ def hold_lock_for_test(double seconds):
 
 
 def check_consistency():
-    """(number of problems, last problem) of the instance invariants."""
+    """(number of problems, the problems) of the instance invariants."""
     need_instance()
     cdef char rep[512]
     cdef int n
     with nogil:
         n = hal_check_consistency(rep, sizeof(rep))
+    check(n)
     return n, rep.decode("utf-8", "replace")
 
 
@@ -1126,6 +1155,152 @@ def items(str kind):
     finally:
         hal_unlock()
     return out
+
+
+def named_items(str kind):
+    """``(name, handle)`` of every object of a kind, in creation order;
+    the names are taken under the lock with the handles, so sorting or
+    filtering by them never fails when an object goes meanwhile."""
+    return [((<Item>it)._name, it) for it in items(kind)]
+
+
+cdef str _pool_str(hal_snapshot_t *s, uint32_t at):
+    return (s.pool + at).decode("utf-8", "replace")
+
+
+cdef object _pool_opt(hal_snapshot_t *s, uint32_t at):
+    return (s.pool + at).decode("utf-8", "replace") if at else None
+
+
+cdef list _records_of(int k, hal_snapshot_t *s):
+    cdef long i
+    cdef uint32_t j
+    cdef hal_snap_t *r
+    cdef hal_snap_sub_t *sub
+    out = []
+    for i in range(s.nrecs):
+        r = &s.recs[i]
+        name = _pool_str(s, r.name)
+        if k == K_PIN:
+            out.append(_records.PinInfo(
+                name, r.type, r.dir, get_raw(r.type, &r.value),
+                _pool_str(s, r.owner), r.id, _pool_opt(s, r.link),
+                _pool_opt(s, r.alias)))
+        elif k == K_PARAM:
+            out.append(_records.ParamInfo(
+                name, r.type, r.dir, get_raw(r.type, &r.value),
+                _pool_str(s, r.owner), r.id, _pool_opt(s, r.alias)))
+        elif k == K_SIG:
+            pins = []
+            for j in range(r.nsub):
+                sub = &s.subs[r.sub + j]
+                pins.append(_records.LinkedPin(_pool_str(s, sub.name),
+                                               sub.dir))
+            out.append(_records.SignalInfo(
+                name, r.type, get_raw(r.type, &r.value), tuple(pins),
+                r.readers, r.writers, r.bidirs))
+        elif k == K_COMP:
+            out.append(_records.ComponentInfo(
+                name, r.id, r.flags & 1 != 0, r.ready != 0, r.pid,
+                hal_pid_alive(r.pid, r.pid_start) != 0))
+        elif k == K_INST:
+            out.append(_records.InstanceInfo(name, r.id,
+                                             _pool_str(s, r.owner)))
+        elif k == K_FUNCT:
+            out.append(_records.FunctionInfo(
+                name, _pool_str(s, r.owner), r.id, r.flags & 1 != 0,
+                r.flags & 2 != 0, r.users, r.flags & 4 == 0, r.time,
+                r.tmax))
+        elif k == K_THREAD:
+            out.append(_records.ThreadInfo(
+                name, r.period, r.flags & 1 != 0, r.flags & 2 != 0,
+                tuple(_pool_str(s, s.subs[r.sub + j].name)
+                      for j in range(r.nsub)),
+                r.time, r.tmax, r.cycles, r.overruns))
+        else:
+            out.append(_records.StreamInfo(name, _pool_str(s, r.owner)))
+    return out
+
+
+def snapshot(str kind):
+    """Records (:mod:`halsdk.core.records`) of every object of a kind, in
+    creation order: names, metadata and values copied by the core in one
+    pass under the lock, so a listing never fails or mixes states when
+    another process changes the instance meanwhile."""
+    need_instance()
+    cdef int k = _KIND_BY_WORD[kind]
+    cdef hal_snapshot_t s
+    cdef int r
+    with nogil:
+        r = hal_snapshot(k, &s)
+    check(r)
+    try:
+        return _records_of(k, &s)
+    finally:
+        hal_snapshot_free(&s)
+
+
+def lock_timeout() -> float:
+    """Seconds a wait for the instance lock lasts before it fails."""
+    return hal_lock_timeout()
+
+
+def set_lock_timeout(double seconds):
+    """Set this process's lock timeout (more than 0, at most 86400 s)."""
+    check(hal_set_lock_timeout(seconds))
+
+
+def lock_holder() -> int:
+    """The pid holding the instance lock now, 0 when none."""
+    need_instance()
+    return hal_map.hdr.lock_holder
+
+
+def _test_offset(str kind, name) -> int:
+    """Test hook: the segment offset of a named object (0: none)."""
+    need_instance()
+    cdef int k = _KIND_BY_WORD[kind]
+    cdef bytes b = enc(name)
+    cdef void *p
+    lock()
+    try:
+        p = hal_find(k, b)
+        return SHMOFF(p) if p != NULL else 0
+    finally:
+        hal_unlock()
+
+
+def _test_poke(hoff_t off, str field, long long value) -> int:
+    """Test hook: write one field of the record at ``off`` (or of the
+    header, ``count.<kind>``) to break an invariant on purpose; returns
+    the old value so that the test can put it back."""
+    need_instance()
+    cdef void *p = SHMPTR(off)
+    cdef long long old
+    if field.startswith("count."):
+        old = hal_map.hdr.count[_KIND_BY_WORD[field[6:]]]
+        hal_map.hdr.count[_KIND_BY_WORD[field[6:]]] = <int32_t>value
+    elif field == "obj.prev":
+        old = (<hal_obj_t *>p).prev
+        (<hal_obj_t *>p).prev = <hoff_t>value
+    elif field == "obj.name0":
+        old = (<hal_obj_t *>p).name[0]
+        (<hal_obj_t *>p).name[0] = <char>value
+    elif field == "item.comp":
+        old = (<hal_item_t *>p).comp
+        (<hal_item_t *>p).comp = <hoff_t>value
+    elif field == "pin.signal":
+        old = (<hal_pin_t *>p).signal
+        (<hal_pin_t *>p).signal = <hoff_t>value
+    elif field == "sig.readers":
+        old = (<hal_sig_t *>p).readers
+        (<hal_sig_t *>p).readers = <int32_t>value
+    elif field == "funct.users":
+        old = (<hal_funct_t *>p).users
+        (<hal_funct_t *>p).users = <int32_t>value
+    else:
+        raise ValueError(f"unknown field {field!r}")
+    return old
 
 
 def comp_by_id(int id):

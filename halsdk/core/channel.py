@@ -193,37 +193,75 @@ class Server:
             return reply
 
 
+def _label(shm: str) -> str:
+    from halsdk.core.instance import instance_label
+    return instance_label(shm)
+
+
+def _gone(shm: str, what: str, exc: BaseException | None = None
+          ) -> errors.HostGoneError:
+    """The error of a channel failure: the instance named, one line."""
+    why = ""
+    if exc is not None:
+        text = getattr(exc, "strerror", None) or str(exc) or \
+            type(exc).__name__
+        why = f" ({text})"
+    return errors.HostGoneError(f"HAL instance '{_label(shm)}': {what}"
+                                f"{why}")
+
+
 def request(shm: str, op: str, *args: Any, timeout: float = 60.0,
             **kwargs: Any) -> Any:
-    """Ask the host of an instance to do ``op``; raise its error."""
-    path = socket_path(shm)
+    """Ask the host of an instance to do ``op``; raise its error.
+
+    A failure of the channel itself (no host listening, the host dying
+    or closing the connection before the whole reply, no answer within
+    ``timeout`` seconds, a garbled reply) raises
+    :class:`~halsdk.errors.HostGoneError` naming the instance, never a
+    bare ``OSError``."""
+    try:
+        path = socket_path(shm)
+    except OSError as exc:
+        raise _gone(shm, "cannot use the request channel folder",
+                    exc) from None
     trust.check_socket(path)
-    sock = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    try:
+        sock = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    except OSError as exc:
+        raise _gone(shm, "cannot open a request channel", exc) from None
     sock.settimeout(timeout)
     try:
         try:
             sock.connect(path)
         except OSError as exc:
-            raise errors.InstanceError(
-                f"cannot reach the host of the HAL instance ({path}): "
-                f"{exc.strerror or exc}") from None
+            raise _gone(shm, f"cannot reach its host ({path})",
+                        exc) from None
         msg = {"op": op, "args": list(args), "kwargs": kwargs}
-        sock.sendall(json.dumps(msg).encode() + b"\n")
         data = b""
-        while not data.endswith(b"\n"):
-            try:
+        try:
+            sock.sendall(json.dumps(msg).encode() + b"\n")
+            while not data.endswith(b"\n"):
                 chunk = sock.recv(65536)
-            except socket.timeout:
-                raise errors.InstanceError(
-                    f"the host did not answer request '{op}' within "
-                    f"{timeout:g} s") from None
-            if not chunk:
-                raise errors.InstanceError(
-                    f"the host closed the channel during request '{op}'")
-            data += chunk
+                if not chunk:
+                    raise _gone(shm, "the host closed the channel during "
+                                f"request '{op}' (did it exit?)")
+                data += chunk
+        except socket.timeout:
+            raise _gone(shm, f"the host did not answer request '{op}' "
+                        f"within {timeout:g} s") from None
+        except errors.HostGoneError:
+            raise
+        except OSError as exc:
+            raise _gone(shm, f"the host went away during request '{op}'",
+                        exc) from None
     finally:
         sock.close()
-    reply = json.loads(data)
+    try:
+        reply = json.loads(data)
+        if not isinstance(reply, dict):
+            raise ValueError("not an object")
+    except ValueError as exc:
+        raise _gone(shm, f"garbled reply to request '{op}'", exc) from None
     if reply.get("ok"):
         return reply.get("result")
     cls = getattr(errors, reply.get("class", ""), None)

@@ -108,6 +108,16 @@ class TrustError(InstanceError):
     does not trust: not owned by the effective user, the wrong mode, more
     than one hard link, or a symbolic link.  The message names the check
     that failed, the file and its owner."""
+class LockTimeoutError(InstanceError, TimeoutError):
+    """The instance lock could not be taken within the lock timeout
+    (``HALSDK_LOCK_TIMEOUT``, default 5 s): the message names the
+    instance and the pid holding the lock (a stopped or stuck process)."""
+
+
+class HostGoneError(InstanceError, ConnectionError):
+    """The host of the instance cannot be reached or went away during a
+    request (refused, reset or closed channel, no answer in time); the
+    message names the instance."""
 
 
 class StaleError(HalError):
@@ -132,6 +142,7 @@ ERRNO_CLASS: dict[int, Callable[..., HalError]] = {
     71: InstanceError,          # EPROTO
     19: InstanceError,          # ENODEV
     13: TrustError,             # EACCES: the trust checks of a segment
+    110: LockTimeoutError,      # ETIMEDOUT
 }
 
 
@@ -147,9 +158,11 @@ __all__ = [
     "ExistsError",
     "HalError",
     "HalTypeError",
+    "HostGoneError",
     "InstanceError",
     "InvalidError",
     "LoadError",
+    "LockTimeoutError",
     "NotFoundError",
     "NotPermittedError",
     "Rule",

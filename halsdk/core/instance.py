@@ -17,7 +17,12 @@ from types import FrameType
 from typing import TYPE_CHECKING, Any, Callable, NoReturn, Optional
 
 from halsdk.core import _core
-from halsdk.core.errors import ExistsError, InstanceError, InvalidError
+from halsdk.core.errors import (
+    ExistsError,
+    HalError,
+    InstanceError,
+    InvalidError,
+)
 
 if TYPE_CHECKING:
     from halsdk.core.channel import Server
@@ -84,6 +89,7 @@ def connect(instance: Optional[str] = None, create: Optional[bool] = None,
     """Create or attach; ``create``: True must create, False must attach,
     None creates when there is no instance."""
     global _conn
+    _lock_timeout_from_env()
     with _conn_lock:
         # no name given: the instance this process already uses
         shm = _conn.shm if instance is None and _conn is not None \
@@ -110,6 +116,23 @@ def connect(instance: Optional[str] = None, create: Optional[bool] = None,
                 _teardown(conn)
                 raise
         return conn
+
+
+def _lock_timeout_from_env() -> None:
+    """``$HALSDK_LOCK_TIMEOUT``: seconds a wait for the instance lock
+    lasts (the core reads it too; here a bad value is an error, not
+    silently the default)."""
+    text = os.environ.get("HALSDK_LOCK_TIMEOUT", "").strip()
+    if not text:
+        return
+    try:
+        seconds = float(text)
+    except ValueError:
+        seconds = float("nan")
+    if not 0 < seconds <= 86400:
+        raise InvalidError(f"HALSDK_LOCK_TIMEOUT={text!r} is not a number "
+                           "of seconds in (0, 86400]")
+    _core.set_lock_timeout(seconds)
 
 
 def _probe_settled(shm: str) -> tuple[Any, ...]:
@@ -245,7 +268,14 @@ def _teardown(conn: Connection) -> None:
             except Exception as exc:  # keep tearing down
                 import sys
                 print(f"halsdk: while closing: {exc}", file=sys.stderr)
-        for comp in _core.items("component"):
+        # the safety net for components left open; a process stopped
+        # while holding the lock (LockTimeoutError) must not turn the
+        # exit into a traceback
+        try:
+            comps = _core.items("component")
+        except HalError:
+            comps = []
+        for comp in comps:
             try:
                 if comp.exists and comp.pid == os.getpid():
                     _core.comp_exit(comp.id)

@@ -268,7 +268,13 @@ def halcmd_main(argv: Optional[list[str]] = None) -> int:
 
 def _halcmd_main(argv: Optional[list[str]] = None) -> int:
     from halsdk import Hal
-    from halsdk.errors import HalError, TrustError
+    from halsdk.errors import (
+        HalError,
+        HostGoneError,
+        InvalidError,
+        LockTimeoutError,
+        TrustError,
+    )
     argv = sys.argv[1:] if argv is None else argv
     opts = _parse(argv, "halcmd")
     if opts.release_only:
@@ -279,7 +285,8 @@ def _halcmd_main(argv: Optional[list[str]] = None) -> int:
         return _check(opts, "halcmd")
     try:
         hal = Hal(create=False)
-    except TrustError as exc:
+    except (TrustError, InvalidError, LockTimeoutError,
+            HostGoneError) as exc:
         print(f"halcmd: {exc}", file=sys.stderr)
         return 1
     except HalError as exc:
@@ -287,12 +294,21 @@ def _halcmd_main(argv: Optional[list[str]] = None) -> int:
               "start one with halrun", file=sys.stderr)
         return 1
     with hal:
-        ex = CommandRunner(hal, keep_going=opts.keep_going, script=opts.script,
-                      verbose=opts.verbose, ini=opts.ini, echo=opts.echo)
+        try:
+            # makes the halcmd<pid> component: takes the instance lock
+            ex = CommandRunner(hal, keep_going=opts.keep_going,
+                               script=opts.script, verbose=opts.verbose,
+                               ini=opts.ini, echo=opts.echo)
+        except HalError as exc:
+            print(f"halcmd: {exc}", file=sys.stderr)
+            return 1
         try:
             return _run(ex, opts, "halcmd")
         finally:
-            ex.unregister()
+            try:
+                ex.unregister()
+            except HalError as exc:
+                print(f"halcmd: {exc}", file=sys.stderr)
 
 
 #: the words of the error of creating an instance that has a live host

@@ -19,7 +19,7 @@ from typing import Callable, Optional
 from halsdk import console
 from halsdk.compat import program_env
 from halsdk.component import Component
-from halsdk.errors import HalError, Rule
+from halsdk.errors import HalError, HostGoneError, LockTimeoutError, Rule
 from halsdk.hal import Hal, is_halcmd_comp
 from halsdk.halcmd.helptext import HELP
 from halsdk.halcmd.lexer import (
@@ -254,6 +254,11 @@ class CommandRunner:
                 raise hal_error(str(exc), f"{words[0]} failed") from None
         except CommandError as exc:
             self.errors += 1
+            if isinstance(exc.__context__, (HostGoneError, LockTimeoutError)):
+                # the instance failed, not the command (its host died, a
+                # stopped process holds the lock): one line that says so
+                self.error(str(exc.__context__))
+                return False
             if self.verbose >= 0:
                 for line in exc.lines:
                     self.err(line + "\n")
@@ -310,8 +315,8 @@ class CommandRunner:
         for kind in _CREATED_KINDS:
             added = after[kind] - before[kind]
             if added > 0:
-                self.created(kind, [it.name for it
-                                    in self.hal.items(kind)[-added:]])
+                self.created(kind, [it.name for it in self.hal.snapshot(
+                    kind, sort=False)[-added:]])
 
     def _locked(self, bit: int) -> bool:
         return bool(self.hal.lock_level & bit)
@@ -384,7 +389,7 @@ class CommandRunner:
                 self.register()
 
     def _rt_modules(self) -> set[str]:
-        return {c.name for c in self.hal.items("component")
+        return {c.name for c in self.hal.snapshot("component", sort=False)
                 if c.realtime and not c.name.startswith("__")}
 
     def cmd_newinst(self, args: list[str]) -> None:
@@ -471,7 +476,8 @@ class CommandRunner:
             # never this process (halcmd would end itself with SIGTERM)
             # nor another halcmd session, as in the reference
             me = os.getpid()
-            names = [c.name for c in self.hal.items("component")
+            names = [c.name
+                     for c in self.hal.snapshot("component", sort=False)
                      if not c.realtime and c.id != self.comp_id
                      and c.pid != me and not is_halcmd_comp(c.name, c.pid)
                      and not c.name.startswith("__")]

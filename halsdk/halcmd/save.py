@@ -25,9 +25,9 @@ _LOCK_LINES = (
 )
 
 
-def _linked(pins: Sequence, sig_name: str) -> list:
-    return [p for p in pins
-            if p.signal is not None and p.signal.name == sig_name]
+def _linked(sig) -> list:
+    """The pins of a signal record, by name."""
+    return sorted(sig.pins, key=lambda p: p.name.encode())
 
 
 class Saver:
@@ -71,8 +71,9 @@ class Saver:
 
     def comps(self) -> None:
         self.out("# components\n")
-        comps = sorted((c for c in self.hal.items("component") if c.realtime),
-                       key=lambda c: c.id)
+        comps = sorted((c for c in self.hal.snapshot("component",
+                                                     sort=False)
+                        if c.realtime), key=lambda c: c.id)
         for c in comps:
             args = self.loadrt_args.get(c.name)
             if args is None:
@@ -90,34 +91,30 @@ class Saver:
 
     def signals(self, unlinked_only: bool) -> None:
         self.out("# signals\n")
-        pins = sorted_items(self.hal, "pin") if unlinked_only else []
         for sig in sorted_items(self.hal, "signal"):
-            if unlinked_only and _linked(pins, sig.name):
+            if unlinked_only and sig.pins:
                 continue
             self.out(f"newsig {sig.name} {type_name(sig.type):<5}\n")
 
     def links(self, arrows: bool) -> None:
         self.out("# links\n")
         for pin in sorted_items(self.hal, "pin"):
-            sig = pin.signal
-            if sig is not None:
+            if pin.signal is not None:
                 arrow = _PIN_ARROW[pin.direction] if arrows else ""
-                self.out(f"linkps {pin.name} {arrow} {sig.name}\n")
+                self.out(f"linkps {pin.name} {arrow} {pin.signal}\n")
 
     def nets(self, arrows: bool) -> None:
         self.out("# nets\n")
-        pins = sorted_items(self.hal, "pin")
         for sig in sorted_items(self.hal, "signal"):
             self.out(f"newsig {sig.name} {type_name(sig.type):<5}\n")
-            for pin in _linked(pins, sig.name):
+            for pin in _linked(sig):
                 arrow = _SIG_ARROW[pin.direction] if arrows else ""
                 self.out(f"linksp {sig.name} {arrow} {pin.name}\n")
 
     def netl(self, arrows: bool) -> None:
         self.out("# nets\n")
-        pins = sorted_items(self.hal, "pin")
         for sig in sorted_items(self.hal, "signal"):
-            linked = _linked(pins, sig.name)
+            linked = _linked(sig)
             if not linked:
                 continue
             if not arrows:
@@ -176,7 +173,8 @@ def status(hal, out: Out, what: str) -> bool:
                           ("parameters", "param")):
             out(f"  active/recycled {word + ':':<11} {counts[key]}/0\n")
         aliases = sum(1 for kind in ("pin", "param")
-                      for it in hal.items(kind) if it.alias_of is not None)
+                      for it in hal.snapshot(kind, sort=False)
+                      if it.alias_of is not None)
         out(f"  active/recycled aliases:    {aliases}/0\n")
         for word, key in (("signals", "signal"), ("functions", "function"),
                           ("threads", "thread")):

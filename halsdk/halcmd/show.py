@@ -58,17 +58,21 @@ def match(patterns: Sequence[str], name: str) -> bool:
 
 
 def sorted_items(hal, kind: str) -> list:
-    return sorted((it for it in hal.items(kind) if it.exists),
+    """Records of every object of a kind, by name.  A snapshot
+    (:meth:`halsdk.Hal.snapshot`): names, metadata and values taken in one
+    pass, so a listing never fails half-way because another process
+    loads or unloads components meanwhile."""
+    return sorted(hal.snapshot(kind, sort=False),
                   key=lambda it: it.name.encode())
 
 
 def components(hal) -> list:
     """Components newest first (the reference's list order)."""
-    return sorted(hal.items("component"), key=lambda c: -c.id)
+    return sorted(hal.snapshot("component", sort=False), key=lambda c: -c.id)
 
 
 def threads(hal) -> list:
-    return list(reversed(hal.items("thread")))
+    return list(reversed(hal.snapshot("thread", sort=False)))
 
 
 class Shower:
@@ -118,10 +122,8 @@ class Shower:
                         f"  {it.name}")
             else:
                 line = f"{it.owner} {tname:<5} {dname} {cell} {it.name}"
-            if kind == "pin":
-                sig = it.signal
-                if sig is not None:
-                    line += f" {_ARROW_PIN[it.direction]} {sig.name}"
+            if kind == "pin" and it.signal is not None:
+                line += f" {_ARROW_PIN[it.direction]} {it.signal}"
             self.out(line + "\n")
 
     def pins(self, patterns: Sequence[str]) -> None:
@@ -185,10 +187,7 @@ class Shower:
                 continue
             fp = "YES" if t.uses_fp else "NO"
             functs = t.functions
-            time_pin = self.hal.find("pin", t.name + ".time")
-            tmax_par = self.hal.find("param", t.name + ".tmax")
-            now = time_pin.value if time_pin is not None else t.time
-            tmax = tmax_par.value if tmax_par is not None else t.tmax
+            now, tmax = t.time, t.tmax      # its .time pin, .tmax param
             if self.script:
                 self.out(f"{t.period} {fp} {t.name} {now:8d} {tmax}"
                          + "".join(" " + f for f in functs) + "\n")

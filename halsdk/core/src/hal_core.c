@@ -193,17 +193,107 @@ static void recover_after_dead_holder(void);
 void *(*hal_gil_release)(void);
 void (*hal_gil_restore)(void *);
 
+/*
+ * How long hal_lock() waits: $HALSDK_LOCK_TIMEOUT (seconds, read on first
+ * use; a value that is not a positive number is ignored) or
+ * HAL_LOCK_TIMEOUT, until hal_set_lock_timeout() sets it for the process.
+ */
+static double lock_timeout_s = -1.0;
+
+double hal_lock_timeout(void)
+{
+    if (lock_timeout_s < 0) {
+        const char *env = getenv("HALSDK_LOCK_TIMEOUT");
+        char *end = NULL;
+        double v = env && *env ? strtod(env, &end) : 0.0;
+        lock_timeout_s = (env && *env && end && *end == 0 && v > 0
+                          && v <= 86400.0) ? v : HAL_LOCK_TIMEOUT;
+    }
+    return lock_timeout_s;
+}
+
+int hal_set_lock_timeout(double seconds)
+{
+    if (!(seconds > 0 && seconds <= 86400.0))
+        return hal_fail(EINVAL, "lock timeout %g s is out of range "
+                        "(more than 0, at most 86400 s)", seconds);
+    lock_timeout_s = seconds;
+    return 0;
+}
+
+/* the command name and state letter of a process, from /proc/pid/stat */
+static int proc_name_state(int pid, char *comm, int len, char *state)
+{
+    char path[64], buf[512];
+    comm[0] = 0;
+    *state = 0;
+    if (pid <= 0)
+        return -1;
+    snprintf(path, sizeof(path), "/proc/%d/stat", pid);
+    int fd = open(path, O_RDONLY);
+    if (fd < 0)
+        return -1;
+    ssize_t n = read(fd, buf, sizeof(buf) - 1);
+    close(fd);
+    if (n <= 0)
+        return -1;
+    buf[n] = 0;
+    char *open_paren = strchr(buf, '(');
+    char *close_paren = strrchr(buf, ')');
+    if (!open_paren || !close_paren || close_paren < open_paren)
+        return -1;
+    int clen = (int)(close_paren - open_paren - 1);
+    if (clen >= len)
+        clen = len - 1;
+    memcpy(comm, open_paren + 1, clen);
+    comm[clen] = 0;
+    if (close_paren[1] == ' ')
+        *state = close_paren[2];
+    return 0;
+}
+
+/* the failure of a wait for the lock that timed out: name the holder */
+static int fail_lock_timeout(hal_header_t *h, double waited)
+{
+    int pid = __atomic_load_n(&h->lock_holder, __ATOMIC_RELAXED);
+    char comm[32], state;
+    if (pid <= 0)
+        return hal_fail(ETIMEDOUT, "HAL instance '%s': instance lock held "
+                        "by an unknown process (stopped?) for more than "
+                        "%g s; gave up", h->instance, waited);
+    if (proc_name_state(pid, comm, sizeof(comm), &state) < 0)
+        return hal_fail(ETIMEDOUT, "HAL instance '%s': instance lock held "
+                        "by pid %d (stopped?) for more than %g s; gave up",
+                        h->instance, pid, waited);
+    return hal_fail(ETIMEDOUT, "HAL instance '%s': instance lock held by "
+                    "pid %d (%s) for more than %g s; gave up (process "
+                    "'%s', state %c)", h->instance, pid,
+                    state == 'T' || state == 't' ? "stopped" : "stopped?",
+                    waited, comm, state ? state : '?');
+}
+
 int hal_lock(void)
 {
     hal_header_t *h = hal_map.hdr;
     if (!h)
         return hal_fail(ENODEV, "no HAL instance is attached");
     /* A holder may be waiting for a thread cycle that runs a Python
-       function: never wait for the mutex with the GIL held. */
+       function: never wait for the mutex with the GIL held.  A holder
+       that is stopped (SIGSTOP) or stuck must not block this process for
+       ever: wait at most the lock timeout. */
     int r = pthread_mutex_trylock(&h->mutex);
+    double waited = 0;
     if (r == EBUSY) {
+        waited = hal_lock_timeout();
+        struct timespec until;
+        clock_gettime(CLOCK_MONOTONIC, &until);
+        long long ns = (long long)(waited * 1e9) + until.tv_nsec;
+        until.tv_sec += ns / 1000000000LL;
+        until.tv_nsec = ns % 1000000000LL;
         void *gil = hal_gil_release ? hal_gil_release() : NULL;
-        r = pthread_mutex_lock(&h->mutex);
+        do
+            r = pthread_mutex_clocklock(&h->mutex, CLOCK_MONOTONIC, &until);
+        while (r == EINTR);
         if (gil)
             hal_gil_restore(gil);
     }
@@ -211,17 +301,23 @@ int hal_lock(void)
         recover_after_dead_holder();
         pthread_mutex_consistent(&h->mutex);
         h->recovered++;
-        return 0;
+        r = 0;
     }
+    if (r == ETIMEDOUT)
+        return fail_lock_timeout(h, waited);
     if (r)
-        return hal_fail(r, "cannot lock the HAL instance: %s", strerror(r));
+        return hal_fail(r, "cannot lock HAL instance '%s': %s", h->instance,
+                        strerror(r));
+    __atomic_store_n(&h->lock_holder, (int32_t)getpid(), __ATOMIC_RELAXED);
     return 0;
 }
 
 void hal_unlock(void)
 {
-    if (hal_map.hdr)
+    if (hal_map.hdr) {
+        __atomic_store_n(&hal_map.hdr->lock_holder, 0, __ATOMIC_RELAXED);
         pthread_mutex_unlock(&hal_map.hdr->mutex);
+    }
 }
 
 /* test hook: hold the lock so that a test can kill the holder */
@@ -1771,6 +1867,27 @@ int hal_set_lock(unsigned char lock)
 /* ---------------------------------------------------------------- */
 /* consistency                                                      */
 
+/* add a problem to the report: "; " between problems, "..." once full */
+static void note(char *rep, int len, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+static void note(char *rep, int len, const char *fmt, ...)
+{
+    int used = (int)strlen(rep);
+    if (used >= len - 4)
+        return;
+    if (used) {
+        snprintf(rep + used, len - used, "; ");
+        used += 2;
+    }
+    va_list ap;
+    va_start(ap, fmt);
+    int n = vsnprintf(rep + used, len - used, fmt, ap);
+    va_end(ap);
+    if (n >= len - used)
+        snprintf(rep + len - 4, 4, "...");
+}
+
 static int fsck_kind(int kind, char *rep, int len, int *bad)
 {
     hal_header_t *h = hal_map.hdr;
@@ -1779,13 +1896,13 @@ static int fsck_kind(int kind, char *rep, int len, int *bad)
     for (hoff_t o = h->list_head[kind]; o;) {
         hal_obj_t *obj = SHMPTR(o);
         if (o >= h->heap_top || obj->kind != kind || obj->prev != prev) {
-            snprintf(rep, len, "%s list broken at offset %u",
+            note(rep, len, "%s list broken at offset %u",
                      kind_word(kind), o);
             (*bad)++;
             return n;
         }
         if (find_in_space(name_space(kind), obj->name) != obj) {
-            snprintf(rep, len, "%s '%s' is not in the name index",
+            note(rep, len, "%s '%s' is not in the name index",
                      kind_word(kind), obj->name);
             (*bad)++;
         }
@@ -1794,63 +1911,170 @@ static int fsck_kind(int kind, char *rep, int len, int *bad)
         o = obj->next;
     }
     if (n != h->count[kind] || prev != h->list_tail[kind]) {
-        snprintf(rep, len, "%s count %d but %d listed", kind_word(kind),
+        note(rep, len, "%s count %d but %d listed", kind_word(kind),
                  h->count[kind], n);
         (*bad)++;
     }
     return n;
 }
 
-/* check the invariants; returns 0 when consistent */
+/* sorted offsets: the index of off, or -1 */
+static int cmp_hoff(const void *a, const void *b)
+{
+    hoff_t x = *(const hoff_t *)a, y = *(const hoff_t *)b;
+    return x < y ? -1 : x > y;
+}
+
+static long index_of_off(const hoff_t *offs, long n, hoff_t off)
+{
+    long lo = 0, hi = n - 1;
+    while (lo <= hi) {
+        long mid = lo + (hi - lo) / 2;
+        if (offs[mid] == off)
+            return mid;
+        if (offs[mid] < off)
+            lo = mid + 1;
+        else
+            hi = mid - 1;
+    }
+    return -1;
+}
+
+/* the offsets of the first n objects of a kind's list, sorted */
+static hoff_t *sorted_offsets(int kind, long n)
+{
+    hoff_t *offs = malloc((n ? n : 1) * sizeof(hoff_t));
+    if (!offs)
+        return NULL;
+    long k = 0;
+    for (hoff_t o = hal_map.hdr->list_head[kind]; o && k < n;
+         o = ((hal_obj_t *)SHMPTR(o))->next)
+        offs[k++] = o;
+    qsort(offs, k, sizeof(hoff_t), cmp_hoff);
+    return offs;
+}
+
+/* an offset of a record of size bytes inside the heap */
+static int in_heap(hoff_t off, size_t size)
+{
+    hal_header_t *h = hal_map.hdr;
+    return off >= h->heap_start && (uint64_t)off + size <= h->heap_top;
+}
+
+/*
+ * Check the invariants; returns the number of problems (0: consistent)
+ * and them in rep ("; " between them, cut with "..." when long), or -errno when it cannot check (the lock
+ * timed out, no memory).  One pass over each
+ * list plus a sort of the signal and function offsets: O(n log n), so
+ * the lock is held briefly even for a large instance (the old pairwise
+ * pin x signal and function x thread loops were quadratic).
+ */
 int hal_check_consistency(char *rep, int len)
 {
     int bad = 0;
     rep[0] = 0;
-    if (hal_lock())
-        return -1;
+    int r = hal_lock();
+    if (r)
+        return r;
+    int n[K_NKINDS] = {0};
     for (int k = 1; k < K_NKINDS; k++)
-        fsck_kind(k, rep, len, &bad);
+        n[k] = fsck_kind(k, rep, len, &bad);
+    hoff_t *sigs = sorted_offsets(K_SIG, n[K_SIG]);
+    hoff_t *functs = sorted_offsets(K_FUNCT, n[K_FUNCT]);
+    int32_t *cnt = calloc(3 * (size_t)(n[K_SIG] ? n[K_SIG] : 1),
+                          sizeof(int32_t));
+    int32_t *users = calloc(n[K_FUNCT] ? n[K_FUNCT] : 1, sizeof(int32_t));
+    if (!sigs || !functs || !cnt || !users) {
+        hal_unlock();
+        free(sigs);
+        free(functs);
+        free(cnt);
+        free(users);
+        return hal_fail(ENOMEM, "out of memory while checking HAL "
+                        "instance '%s'", hal_map.hdr->instance);
+    }
+    /* links: count each signal's pins by direction */
+    long np = 0;
+    FOR_EACH(K_PIN, hal_pin_t, p) {
+        if (np++ >= n[K_PIN])
+            break;
+        long i = p->signal ? index_of_off(sigs, n[K_SIG], p->signal) : -1;
+        if (i >= 0) {
+            cnt[3 * i] += p->dir == HALSDK_IN;
+            cnt[3 * i + 1] += p->dir == HALSDK_OUT;
+            cnt[3 * i + 2] += p->dir == HALSDK_IO;
+        }
+    }
+    long ns = 0;
     FOR_EACH(K_SIG, hal_sig_t, s) {
-        int rd = 0, wr = 0, io = 0;
-        hoff_t so = SHMOFF(s);
-        FOR_EACH(K_PIN, hal_pin_t, p)
-            if (p->signal == so) {
-                rd += p->dir == HALSDK_IN;
-                wr += p->dir == HALSDK_OUT;
-                io += p->dir == HALSDK_IO;
-            }
+        if (ns >= n[K_SIG])
+            break;
+        long i = index_of_off(sigs, n[K_SIG], SHMOFF(s));
+        int rd = cnt[3 * i], wr = cnt[3 * i + 1], io = cnt[3 * i + 2];
+        ns++;
         if (rd != s->readers || wr != s->writers || io != s->bidirs ||
             wr > 1 || (wr && io)) {
-            snprintf(rep, len, "signal '%s' link counts are wrong",
+            note(rep, len, "signal '%s' link counts are wrong",
                      s->o.name);
             bad++;
         }
     }
+    np = 0;
     FOR_EACH(K_PIN, hal_pin_t, p) {
-        hal_obj_t *c = SHMPTR(p->comp);
-        if (c->kind != K_COMP) {
-            snprintf(rep, len, "pin '%s' has no owner", p->o.name);
+        if (np++ >= n[K_PIN])
+            break;
+        if (!in_heap(p->comp, sizeof(hal_obj_t)) ||
+            ((hal_obj_t *)SHMPTR(p->comp))->kind != K_COMP) {
+            note(rep, len, "pin '%s' has no owner", p->o.name);
             bad++;
         }
-        if (p->signal && ((hal_obj_t *)SHMPTR(p->signal))->kind != K_SIG) {
-            snprintf(rep, len, "pin '%s' is linked to a deleted signal",
+        if (p->signal && index_of_off(sigs, n[K_SIG], p->signal) < 0) {
+            note(rep, len, "pin '%s' is linked to a deleted signal",
                      p->o.name);
             bad++;
         }
     }
+    /* thread entries: count each function's users */
+    long nt = 0;
+    FOR_EACH(K_THREAD, hal_thread_t, t) {
+        if (nt++ >= n[K_THREAD])
+            break;
+        long guard = 0;
+        for (hoff_t e = t->functs; e && guard++ <= n[K_FUNCT] * 64L + 64;
+             e = ((hal_fentry_t *)SHMPTR(e))->next) {
+            if (!in_heap(e, sizeof(hal_fentry_t))) {
+                note(rep, len, "thread '%s' function list is broken",
+                         t->o.name);
+                bad++;
+                break;
+            }
+            long i = index_of_off(functs, n[K_FUNCT],
+                                  ((hal_fentry_t *)SHMPTR(e))->funct);
+            if (i >= 0)
+                users[i]++;
+            else {
+                note(rep, len, "thread '%s' calls a deleted function",
+                         t->o.name);
+                bad++;
+            }
+        }
+    }
+    long nf = 0;
     FOR_EACH(K_FUNCT, hal_funct_t, f) {
-        int users = 0;
-        FOR_EACH(K_THREAD, hal_thread_t, t)
-            for (hoff_t e = t->functs; e;
-                 e = ((hal_fentry_t *)SHMPTR(e))->next)
-                users += ((hal_fentry_t *)SHMPTR(e))->funct == SHMOFF(f);
-        if (users != f->users) {
-            snprintf(rep, len, "function '%s' has %d users, %d counted",
-                     f->o.name, f->users, users);
+        if (nf++ >= n[K_FUNCT])
+            break;
+        long i = index_of_off(functs, n[K_FUNCT], SHMOFF(f));
+        if (users[i] != f->users) {
+            note(rep, len, "function '%s' has %d users, %d counted",
+                     f->o.name, f->users, users[i]);
             bad++;
         }
     }
     hal_unlock();
+    free(sigs);
+    free(functs);
+    free(cnt);
+    free(users);
     return bad;
 }
 

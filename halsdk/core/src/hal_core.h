@@ -20,7 +20,7 @@
 #include <sys/types.h>
 
 #define HAL_MAGIC 0x31304b4453474c48ULL   /* "HLGSDK01" */
-#define HAL_ABI_VERSION 3
+#define HAL_ABI_VERSION 4
 #define HAL_NAME_SIZE (HALSDK_NAME_LEN + 1)
 #define HAL_DEFAULT_SIZE (160L * 1024 * 1024)
 #define HAL_MIN_SIZE (1L * 1024 * 1024)
@@ -225,6 +225,7 @@ typedef struct {
     int32_t threads_running;
     int32_t recovered;          /* times a dead lock holder was cleaned up */
     int32_t naliases;           /* pins and params that have an alias */
+    int32_t lock_holder;        /* pid holding the mutex, 0: none (ABI 4) */
 } hal_header_t;
 
 /* a mapping of an instance in this process */
@@ -297,8 +298,13 @@ int hal_instance_probe(const char *shm_name, int *host_pid,
 uint64_t hal_proc_start_time(int pid);
 int hal_pid_alive(int pid, uint64_t start);
 
-/* mutex */
+/* mutex: hal_lock() waits at most hal_lock_timeout() seconds (default
+   HAL_LOCK_TIMEOUT, or $HALSDK_LOCK_TIMEOUT), then fails with ETIMEDOUT
+   naming the holder.  The realtime threads never take it. */
+#define HAL_LOCK_TIMEOUT 5.0
 int hal_lock(void);
+double hal_lock_timeout(void);
+int hal_set_lock_timeout(double seconds);
 /* set by the Python binding: drop and retake the GIL around a wait */
 extern void *(*hal_gil_release)(void);
 extern void (*hal_gil_restore)(void *);
@@ -402,6 +408,45 @@ int hal_symbol_export(const char *name, void *addr, const char *module);
 void *hal_symbol_find(const char *name, const char *user);
 void hal_symbol_drop(const char *module);
 const char *hal_symbol_user(const char *module);
+
+/*
+ * Listings (hal_snapshot.c): every object of a kind copied in one pass
+ * under the lock.  Strings are offsets into pool (0: none / empty); the
+ * pins of a signal and the functions of a thread are subs[sub ..
+ * sub + nsub - 1].  Per kind: id is the component or instance id (pins,
+ * params, functions: the owner's id); flags: component 1 realtime;
+ * function 1 uses_fp, 2 reentrant, 4 Python; thread 1 uses_fp, 2 running.
+ */
+typedef struct {
+    hoff_t off;
+    uint32_t gen;
+    uint32_t name, owner, link, alias;  /* link: a pin's signal; alias:
+                                           the original name */
+    int32_t id, type, dir, flags;
+    int32_t ready, pid, users, time, tmax;
+    int32_t readers, writers, bidirs;
+    uint32_t sub, nsub;
+    int64_t period;
+    uint64_t pid_start, cycles, overruns;
+    uint64_t value;                     /* the value's bytes */
+} hal_snap_t;
+
+typedef struct {
+    uint32_t name;
+    int32_t dir;
+} hal_snap_sub_t;
+
+typedef struct {
+    hal_snap_t *recs;
+    long nrecs, caprecs;
+    hal_snap_sub_t *subs;
+    long nsubs, capsubs;
+    char *pool;
+    long npool, cappool;
+} hal_snapshot_t;
+
+int hal_snapshot(int kind, hal_snapshot_t *snap);   /* takes the lock */
+void hal_snapshot_free(hal_snapshot_t *snap);
 
 /* values */
 hal_value_t *hal_pin_value(hal_pin_t *pin);

@@ -100,7 +100,10 @@ static inline int32_t tick_ns(uint64_t d)
     return ns > 2147483647.0 ? 2147483647 : (int32_t)ns;
 }
 
-/* one cycle of a thread: the realtime path */
+/* one cycle of a thread: the realtime path.  It never calls hal_lock()
+   (nor anything that does): a process stopped while it holds the
+   instance lock cannot stall a thread, and the lock's timeout (hal_lock)
+   concerns metadata changes and listings only. */
 static void run_cycle(executor_t *x)
 {
     atomic_fetch_add_explicit(&x->epoch, 1, memory_order_seq_cst);
