@@ -80,7 +80,11 @@ static void host_ended(void)
     if (!watch_end)
         return;
     say_host_ended();
-    kill(getpid(), SIGTERM);
+    /* to the main thread (its tid is the pid): a blocking call there is
+       interrupted, so a Python handler runs at once */
+    pid_t me = getpid();
+    if (syscall(SYS_tgkill, me, me, SIGTERM) != 0)
+        kill(me, SIGTERM);
 }
 
 static void *watch_main(void *arg)
