@@ -42,6 +42,7 @@ core = Extension(
         "halsdk/core/src/hal_shmem.c",
         "halsdk/core/src/hal_symbol.c",
         "halsdk/core/src/hal_snapshot.c",
+        "halsdk/core/src/hal_liveness.c",
     ],
     include_dirs=["halsdk/include", "halsdk/core/src"],
     extra_compile_args=FLAGS,

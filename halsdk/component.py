@@ -17,6 +17,13 @@ class Component:
     prefix).  The component and its pins disappear with :meth:`exit`, when
     the process exits, or when the host unloads it.
 
+    A process with a userspace component ends with the instance's host:
+    the moment the host ends (however: exit, crash, SIGKILL) the process
+    gets SIGTERM after a line on stderr naming the instance and the host's
+    pid (``docs/halcmd.rst``, "When a process dies").  If this process
+    itself dies without removing the component, the host marks it
+    ``dead`` and sets its out pins to zero.
+
     ``realtime=True`` makes a realtime component instead: what a module
     loaded with ``loadrt`` in the host makes (e.g. ``threads``).
     """
@@ -38,6 +45,10 @@ class Component:
         self.prefix = prefix if prefix is not None else name
         self._items: dict[str, Any] = {}
         self._exited = False
+        if self._conn is not None and not realtime:
+            # a userspace component's process ends with the host
+            # (SIGTERM and a line on stderr the moment the host ends)
+            instance.watch_host(self._conn, end_process=True)
 
     def _full(self, name: str) -> str:
         return f"{self.prefix}.{name}" if self.prefix else name
@@ -106,6 +117,12 @@ class Component:
             return False
         comp = _core.comp_by_id(self.id)
         return comp is not None and comp.name == self.name
+
+    @property
+    def host_gone(self) -> int:
+        """The pid of the instance's host once it has ended (this
+        process then gets SIGTERM), else 0."""
+        return instance.host_gone()
 
     def exit(self) -> None:
         """Remove the component and its pins."""

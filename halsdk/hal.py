@@ -118,6 +118,39 @@ class Hal:
         """Size, usage, counts, host pid and clock state of the instance."""
         return _core.info()
 
+    def end_with_host(self, who: Optional[str] = None) -> None:
+        """End this attached process when the host ends: the moment it
+        ends (exit, crash, SIGKILL), a line naming the instance and the
+        host's pid goes to stderr (as ``who``, default the program's name)
+        and this process gets SIGTERM.  A userspace component does this
+        by itself (:class:`halsdk.Component`); nothing on the host."""
+        instance.watch_host(self._conn, True, who)
+
+    @property
+    def host_gone(self) -> int:
+        """The pid of the host once it was seen to end (after
+        :meth:`end_with_host` or with a userspace component), else 0."""
+        return instance.host_gone()
+
+    def child_preexec(self) -> Optional[Callable[[], None]]:
+        """A ``preexec_fn`` for a program that this process starts and
+        that must end with it: on the host's main thread, the child gets
+        SIGTERM when the host ends in any way (``PR_SET_PDEATHSIG``, which
+        the kernel ties to the starting thread); None elsewhere (an
+        attached halcmd's programs are not its children in HAL terms: a
+        halsdk program watches the host itself)."""
+        import threading
+        if not self._conn.host or \
+                threading.current_thread() is not threading.main_thread():
+            return None
+        parent = os.getpid()
+
+        def preexec() -> None:
+            _core.set_parent_death_signal(int(_signal.SIGTERM))
+            if os.getppid() != parent:      # the host ended already
+                os.kill(os.getpid(), _signal.SIGTERM)
+        return preexec
+
     def _call_host(self, op: str, *args: Any, **kwargs: Any) -> Any:
         if self._conn.host:
             return getattr(self, "_host_" + op)(*args, **kwargs)

@@ -12,7 +12,9 @@ default action: the process ends at once, whatever ``user_mainloop`` is
 doing); ``halcmd unload NAME`` / ``Hal.unload(NAME)`` send ``SIGTERM``
 and then remove the component of the dead process.  When
 ``user_mainloop`` returns, the component is removed and the program ends
-with status 0.
+with status 0.  When the instance's host ends, however it ends, the
+program ends too: a line on stderr names the instance and the host's pid,
+then SIGTERM ends it (``Hal.end_with_host``).
 
 ``python -m halsdk.userspace MODULE_FILE args...`` runs a module without a
 launcher script.
@@ -43,6 +45,9 @@ def run(module_path: str, argv: Sequence[str]) -> int:
     prog = os.path.basename(argv[0]) if argv else name
     try:
         hal = Hal(create=False)
+        # ends with the host: a line on stderr and SIGTERM (which ends
+        # the program at once, see below) the moment the host ends
+        hal.end_with_host(prog)
     except HalError as exc:
         print(f"{prog}: {exc}", file=sys.stderr)
         return 1

@@ -132,6 +132,16 @@ class Cia402Driver(Driver):
         for link in self.drives:
             link.attach(network)
 
+    def safe_state(self) -> None:
+        """Drives disabled: every drive's power stage off, applied by a
+        SYNC (close() does it again before NMT stop)."""
+        network = self.network
+        if network is None:
+            return
+        for link in self.drives:
+            link.switch_off()
+        network.send_message(0x80, b"")
+
     def close(self) -> None:
         network, self.network = self.network, None
         if network is not None:

@@ -206,7 +206,29 @@ class LinkWorker:
                 except Exception as exc:
                     self._crashed_outside(exc)
         finally:
+            self.go_safe()
             self.conn.close()
+
+    def go_safe(self) -> None:
+        """The safe state, when the link stops for any reason (SIGTERM,
+        ``unloadusr``, the HAL host gone): every coil that a write
+        transaction (functions 5, 15) drives is written OFF once, if the
+        link is open.  Registers are left as they are: a zero register is
+        not safe for every device (use the device's own communication
+        watchdog for those)."""
+        if not self.conn.is_open:
+            return
+        for runner in self.runners:
+            tx = runner.tx
+            if tx.function not in (5, 15) or tx.unusable:
+                continue
+            try:
+                self.conn.execute(tx, [0] * tx.count)
+            except Exception as exc:    # the device may be gone already
+                if self.debug >= DEBUG_ERR:
+                    log.error("%s: transaction %s: coils OFF at stop: %s",
+                              tx.line, tx.name,
+                              str(exc) or type(exc).__name__)
 
     def _crashed(self, exc: Exception, where: str = "") -> None:
         """An unexpected error: log it once, close the connection and
@@ -343,7 +365,8 @@ class Mb2hal:
         return sum(r.ok_count for r in self.runners)
 
     def run(self) -> None:
-        """Start, then serve until SIGTERM/SIGINT or ``unloadusr``."""
+        """Start, then serve until SIGTERM/SIGINT, ``unloadusr`` or the
+        end of the HAL host; coils go OFF then (:meth:`LinkWorker.go_safe`)."""
         done = threading.Event()
         old = {}
         if threading.current_thread() is threading.main_thread():
@@ -353,6 +376,8 @@ class Mb2hal:
             self.start()
             while not done.wait(0.1):
                 if self.comp is None or not self.comp.exists:
+                    break
+                if self.comp.host_gone:     # said on stderr by the core
                     break
         finally:
             self.stop()

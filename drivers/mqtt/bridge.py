@@ -316,6 +316,8 @@ class Bridge:
                     log.info("%s: component removed, stopping",
                              self.cfg.name)
                     break
+                if comp.host_gone:      # said on stderr by the core
+                    break
                 try:
                     self.cycle()
                 except HalError:

@@ -10,9 +10,18 @@ this module is its engine and is not meant to be used directly.
 from libc.stdint cimport int16_t, int32_t, int64_t, uint8_t, uint16_t, \
     uint32_t, uint64_t
 from libc.string cimport memset
+from libc.errno cimport errno
+
 from cpython.pycapsule cimport PyCapsule_New
 from cpython.ref cimport PyObject, Py_INCREF, Py_DECREF
 from cpython.mem cimport PyMem_Malloc, PyMem_Free
+
+
+cdef extern from "sys/prctl.h" nogil:
+    int prctl(int option, unsigned long a2, unsigned long a3,
+              unsigned long a4, unsigned long a5)
+    enum:
+        PR_SET_PDEATHSIG
 
 import os
 import re
@@ -55,6 +64,7 @@ cdef extern from "hal_core.h" nogil:
     ctypedef struct hal_obj_t:
         hoff_t next, prev
         uint16_t kind
+        uint16_t flags
         uint32_t gen
         char name[128]
 
@@ -177,6 +187,11 @@ cdef extern from "hal_core.h" nogil:
                            int *abi)
     uint64_t hal_proc_start_time(int pid)
     int hal_pid_alive(int pid, uint64_t start)
+    int hal_watch_host(int end_process, const char *who)
+    int hal_host_gone()
+    int hal_comp_mark_dead(int id)
+    enum:
+        HAL_COMP_DEAD
     int hal_lock()
     void hal_unlock()
     double hal_lock_timeout()
@@ -710,6 +725,12 @@ cdef class Component(Item):
         cdef hal_comp_t *c = <hal_comp_t *>self.rec()
         return hal_pid_alive(c.pid, c.pid_start) != 0
 
+    @property
+    def dead(self) -> bool:
+        """True once the host marked the component dead: its process
+        ended without removing it (its out pins were set to zero)."""
+        return ((<hal_comp_t *>self.rec()).o.flags & HAL_COMP_DEAD) != 0
+
 
 cdef class Instance(Item):
     """An instance added to a component at run time (newinst)."""
@@ -1043,6 +1064,37 @@ def probe(str shm_name):
 
 def pid_alive(int pid, uint64_t start=0) -> bool:
     return hal_pid_alive(pid, start) != 0
+
+
+def watch_host(bint end_process=False, str who="halsdk"):
+    """Watch the host of the attached instance from a thread of the core
+    (a pidfd, no GIL needed); with ``end_process``, when the host ends,
+    write a line naming it to stderr and SIGTERM this process."""
+    need_instance()
+    check(hal_watch_host(end_process, enc(who)))
+
+
+def host_gone() -> int:
+    """The pid of the host once its end was seen by :func:`watch_host`,
+    else 0."""
+    return hal_host_gone()
+
+
+def comp_mark_dead(int comp_id):
+    """Host: mark the userspace component of an ended process dead and
+    set its out pins to zero."""
+    need_instance()
+    cdef int r
+    with nogil:
+        r = hal_comp_mark_dead(comp_id)
+    check(r)
+
+
+def set_parent_death_signal(int signum):
+    """prctl(PR_SET_PDEATHSIG): this process gets ``signum`` when the
+    thread that started it ends (for a child between fork and exec)."""
+    if prctl(PR_SET_PDEATHSIG, <unsigned long>signum, 0, 0, 0) != 0:
+        raise OSError(errno, "prctl(PR_SET_PDEATHSIG) failed")
 
 
 def proc_start_time(int pid) -> int:

@@ -70,6 +70,7 @@ class Connection:
         # loader, the layer above it)
         self.registry: Any = None
         self.lock = threading.RLock()
+        self.reaper: Optional[Reaper] = None    # on the host
 
     @property
     def label(self) -> str:
@@ -112,6 +113,7 @@ def connect(instance: Optional[str] = None, create: Optional[bool] = None,
             from halsdk.core import channel
             try:
                 conn.server = channel.Server(conn)
+                conn.reaper = Reaper()
             except Exception:
                 _teardown(conn)
                 raise
@@ -133,6 +135,140 @@ def _lock_timeout_from_env() -> None:
         raise InvalidError(f"HALSDK_LOCK_TIMEOUT={text!r} is not a number "
                            "of seconds in (0, 86400]")
     _core.set_lock_timeout(seconds)
+def watch_host(conn: Connection, end_process: bool,
+               who: Optional[str] = None) -> None:
+    """In an attached process: watch the host (a thread of the core
+    waits on a pidfd of the host's pid).  With ``end_process`` the process
+    gets SIGTERM, after a line on stderr naming the instance and the host,
+    the moment the host ends, however it ends.  Nothing on the host."""
+    if conn.host:
+        return
+    if who is None:
+        import sys
+        who = os.path.basename(sys.argv[0]) if sys.argv and sys.argv[0] \
+            else "python"
+        if who in ("-c", "-m", "__main__.py", ""):
+            who = "python"
+    _core.watch_host(end_process, who)
+
+
+def host_gone() -> int:
+    """The pid of this process's host once the watch saw it end, else 0
+    (always 0 without :func:`watch_host`)."""
+    return _core.host_gone() if _conn is not None else 0
+
+
+class Reaper:
+    """The host's watch over the processes of userspace components.
+
+    A daemon thread waits on a pidfd of each process that owns a userspace
+    component (the kernel wakes it when one ends) and, every 0.1 s, looks
+    at the instance's change counter for components added or removed.  A
+    component whose process ended without removing it is marked dead
+    (``show comp`` says ``dead``) and its out pins are set to zero by the
+    core; the ``halcmd<pid>`` component of a dead halcmd is removed.
+    Nothing of this runs in the realtime threads.
+    """
+
+    PERIOD = 0.1
+
+    def __init__(self) -> None:
+        self._stop = threading.Event()
+        self._wake_r, self._wake_w = os.pipe2(os.O_CLOEXEC)
+        self._fds: dict[int, int] = {}          # component id -> pidfd
+        self._polled: set[int] = set()          # ids without a pidfd
+        self._thread = threading.Thread(target=self._run,
+                                        name="halsdk-reaper", daemon=True)
+        self._thread.start()
+
+    def close(self) -> None:
+        """Stop the thread (before the instance is unmapped)."""
+        self._stop.set()
+        try:
+            os.write(self._wake_w, b"x")
+        except OSError:
+            pass
+        if threading.current_thread() is not self._thread:
+            self._thread.join(timeout=10)
+        for fd in (*self._fds.values(), self._wake_r, self._wake_w):
+            try:
+                os.close(fd)
+            except OSError:
+                pass
+        self._fds.clear()
+
+    def _run(self) -> None:
+        import select
+        serial = None
+        while not self._stop.is_set():
+            try:
+                now = _core.serial()
+                if now != serial:
+                    serial = now
+                    self._rescan()
+                poller = select.poll()
+                poller.register(self._wake_r, select.POLLIN)
+                by_fd = {}
+                for cid, fd in self._fds.items():
+                    poller.register(fd, select.POLLIN)
+                    by_fd[fd] = cid
+                ended = [by_fd[fd] for fd, _ev in
+                         poller.poll(self.PERIOD * 1000) if fd in by_fd]
+                for cid in list(self._polled):
+                    comp = _core.comp_by_id(cid)
+                    if comp is None or not comp.alive:
+                        ended.append(cid)
+                for cid in ended:
+                    if not self._stop.is_set():
+                        self._ended(cid)
+            except Exception as exc:    # never let the watch die silently
+                if self._stop.is_set():
+                    return
+                import sys
+                print(f"halsdk: watching userspace components: {exc}",
+                      file=sys.stderr)
+                self._stop.wait(self.PERIOD)
+
+    def _rescan(self) -> None:
+        me = os.getpid()
+        present = set()
+        for comp in _core.items("component"):
+            if comp.realtime or comp.pid == me or comp.dead:
+                continue
+            cid = comp.id
+            present.add(cid)
+            if cid in self._fds or cid in self._polled:
+                continue
+            try:
+                fd = os.pidfd_open(comp.pid)
+            except ProcessLookupError:
+                self._ended(cid)
+                continue
+            except OSError:             # no pidfds: look every PERIOD
+                self._polled.add(cid)
+                continue
+            self._fds[cid] = fd
+            if not comp.alive:          # the pid was reused meanwhile
+                self._ended(cid)
+        for cid in set(self._fds) - present:
+            os.close(self._fds.pop(cid))
+        self._polled &= present
+
+    def _ended(self, cid: int) -> None:
+        fd = self._fds.pop(cid, None)
+        if fd is not None:
+            os.close(fd)
+        self._polled.discard(cid)
+        comp = _core.comp_by_id(cid)
+        if comp is None or comp.alive:
+            return
+        try:
+            if comp.name == f"halcmd{comp.pid}":
+                _core.comp_exit(cid)    # a halcmd session's bookkeeping
+            else:
+                _core.comp_mark_dead(cid)
+        except HalError:
+            pass                        # removed meanwhile (unload)
 
 
 def _probe_settled(shm: str) -> tuple[Any, ...]:
@@ -256,6 +392,9 @@ def _teardown(conn: Connection) -> None:
         if conn.host:
             if conn.server is not None:
                 conn.server.close()
+            if conn.reaper is not None:
+                conn.reaper.close()
+                conn.reaper = None
             try:
                 _core.stop()
             except Exception:

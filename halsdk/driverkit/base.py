@@ -34,7 +34,9 @@ class Driver:
 
     - :meth:`setup` -- create the channels (``self.digin(n)`` …), once;
     - :meth:`open` / :meth:`close` -- connect to and release the device;
-    - :meth:`read` / :meth:`write` -- move values between device and pins.
+    - :meth:`read` / :meth:`write` -- move values between device and pins;
+    - :meth:`safe_state` -- outputs off when the loop ends (any reason,
+      the host's death included).
 
     :meth:`start` creates the component ``<name>.<num>`` (component name
     and pin prefix alike, so several devices can run at once; pass
@@ -72,6 +74,16 @@ class Driver:
 
     def write(self) -> None:
         """Write the output pins to the device."""
+
+    def safe_state(self) -> None:
+        """Put the device in its safe state: outputs off, drives
+        disabled, brakes on, "offline" published.  Called once, while the
+        device is open, when the loop ends for any reason -- SIGTERM,
+        ``unloadusr``, :meth:`IOLoop.stop`, or the instance's host gone
+        (the process gets SIGTERM then) -- before :meth:`close`.  It must
+        not rely on HAL values (the host may be dead: the pins hold
+        stale values) and should take well under a second.  The default
+        does nothing."""
 
     # -- channels ----------------------------------------------------------
     def _require(self) -> Component:

@@ -123,10 +123,12 @@ class IOLoop:
     # -- running -----------------------------------------------------------
     def run(self, handle_signals: bool = True) -> None:
         """Start, cycle every period until :meth:`stop` (or SIGTERM/SIGINT
-        when ``handle_signals`` and on the main thread) or until the
-        component is removed (``unloadusr``), then close the device and
-        remove the component.  For ``loadusr`` processes; a component that
-        cannot be created ends the process with a message and status 1."""
+        when ``handle_signals`` and on the main thread), until the
+        component is removed (``unloadusr``) or until the instance's host
+        is gone, then put the device in its safe state
+        (:meth:`Driver.safe_state`), close it and remove the component.
+        For ``loadusr`` processes; a component that cannot be created
+        ends the process with a message and status 1."""
         old = {}
         if handle_signals and threading.current_thread() is \
                 threading.main_thread():
@@ -146,6 +148,8 @@ class IOLoop:
                     log.warning("%s: component removed, stopping",
                                 self.driver.prefix)
                     break
+                if comp.host_gone:      # said on stderr by the core
+                    break
                 try:
                     self.cycle()
                 except HalError:
@@ -161,9 +165,20 @@ class IOLoop:
         finally:
             if self.connected:
                 self.connected = False
+                self.go_safe()
             self.driver.shutdown()
             for sig, handler in old.items():
                 signal.signal(sig, handler)
+
+    def go_safe(self) -> None:
+        """Call the driver's :meth:`Driver.safe_state`; an error is
+        logged (one line), never raised."""
+        d = self.driver
+        try:
+            d.safe_state()
+        except Exception as exc:
+            log.error("%s: safe state: %s", d.prefix,
+                      str(exc) or type(exc).__name__)
 
     def start_thread(self) -> threading.Thread:
         """Run the loop in a daemon thread (no signal handling)."""

@@ -433,9 +433,11 @@ class CommandRunner:
         try:
             # the compat hal/linuxcnc modules importable, as the
             # reference's halrun makes its own for the programs it starts
+            # and ends with the host, however the host ends
             child = subprocess.Popen([_program_path(prog), *args[1:]],
                                      stdin=subprocess.DEVNULL,
-                                     cwd=self.workdir, env=program_env())
+                                     cwd=self.workdir, env=program_env(),
+                                     preexec_fn=self.hal.child_preexec())
         except OSError as exc:
             raise CommandError(f"execv({prog}): {exc.strerror}",
                                f"program '{prog}' failed, returned 1"

@@ -105,7 +105,8 @@ class Shower:
                 continue
             kind = "RT" if c.realtime else "User"
             pid = "" if c.realtime else str(c.pid)
-            state = "ready" if c.ready else "initializing"
+            state = ("dead" if not c.realtime and (c.dead or not c.alive)
+                     else "ready" if c.ready else "initializing")
             self.out(f" {c.id:5d}  {kind:<4}  {c.name:<{NAME_LEN}} "
                      f"{pid:>5} {state}\n")
         self.out("\n")

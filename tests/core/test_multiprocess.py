@@ -501,13 +501,18 @@ def test_sigkill_of_component_process(hal, spawn):
     hal.step(3)
     assert thread.cycles == cycles + 3
 
+    # the host marks it dead and zeroes the signal its out pin drove
+    # (tests/core/test_liveness.py); the signal it read keeps its value
+    wait_for(lambda: comp.dead, "the host to mark the component dead")
+    assert hal.gets("fb") == 0.0
+
     # the dead component is removed; its signals stay with their values
     hal.unload("childcomp")
     assert not comp.exists
     assert hal.components("childcomp") == []
     assert hal.pins("childcomp.*") == []
     fb, cmd = hal.signal("fb"), hal.signal("cmd")
-    assert fb.value == 2.5
+    assert fb.value == 0.0
     assert cmd.value == 2.5
     assert (fb.writers, fb.readers, cmd.writers, cmd.readers) == (0, 0, 0, 0)
     hal.check()

@@ -2403,6 +2403,7 @@ void hal_instance_detach(int unlink_shm, const char *shm_name)
 {
     if (!hal_map.hdr)
         return;
+    hal_unwatch_host();
     if (hal_map.is_host)
         exec_destroy_all();
     munmap(hal_map.base, hal_map.size);

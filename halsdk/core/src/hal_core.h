@@ -62,6 +62,10 @@ typedef struct {
     char name[HAL_NAME_SIZE];
 } hal_obj_t;
 
+/* hal_comp_t o.flags: the process of the userspace component has ended
+   (hal_liveness.c) */
+#define HAL_COMP_DEAD 0x0001
+
 typedef struct {
     hal_obj_t o;
     int32_t id;
@@ -455,6 +459,17 @@ void *hal_param_value(hal_param_t *param);
 /* time */
 long long hal_get_time(void);
 long long hal_get_clocks(void);
+
+/* liveness (hal_liveness.c) */
+int hal_pidfd_open(int pid);                /* -1 and errno on failure */
+/* an attached process: watch the host; end_process: when it ends, say so
+   on stderr (as who) and SIGTERM this process */
+int hal_watch_host(int end_process, const char *who);
+void hal_unwatch_host(void);
+int hal_host_gone(void);                    /* its pid once ended, else 0 */
+/* the host: a userspace component whose process ended is marked dead
+   and its out pins set to zero; takes the lock */
+int hal_comp_mark_dead(int id);
 
 /* executor (hal_thread.c) */
 int exec_create(hal_thread_t *t);
