@@ -1254,7 +1254,7 @@ cdef list _records_of(int k, hal_snapshot_t *s):
         elif k == K_COMP:
             out.append(_records.ComponentInfo(
                 name, r.id, r.flags & 1 != 0, r.ready != 0, r.pid,
-                hal_pid_alive(r.pid, r.pid_start) != 0))
+                hal_pid_alive(r.pid, r.pid_start) != 0, r.flags & 2 != 0))
         elif k == K_INST:
             out.append(_records.InstanceInfo(name, r.id,
                                              _pool_str(s, r.owner)))

@@ -22,6 +22,8 @@ class ComponentInfo(NamedTuple):
     ready: bool
     pid: int
     alive: bool
+    #: the host marked it dead: its process ended without removing it
+    dead: bool = False
 
 
 class InstanceInfo(NamedTuple):

@@ -418,7 +418,7 @@ const char *hal_symbol_user(const char *module);
  * under the lock.  Strings are offsets into pool (0: none / empty); the
  * pins of a signal and the functions of a thread are subs[sub ..
  * sub + nsub - 1].  Per kind: id is the component or instance id (pins,
- * params, functions: the owner's id); flags: component 1 realtime;
+ * params, functions: the owner's id); flags: component 1 realtime, 2 dead;
  * function 1 uses_fp, 2 reentrant, 4 Python; thread 1 uses_fp, 2 running.
  */
 typedef struct {

@@ -194,7 +194,8 @@ static int snap_one(hal_snapshot_t *s, int kind, hal_obj_t *o)
     case K_COMP: {
         hal_comp_t *c = (hal_comp_t *)o;
         r->id = c->id;
-        r->flags = c->kind == HALSDK_COMP_RT;
+        r->flags = (c->kind == HALSDK_COMP_RT)
+            | ((c->o.flags & HAL_COMP_DEAD) ? 2 : 0);
         r->ready = c->ready;
         r->pid = c->pid;
         r->pid_start = c->pid_start;
