@@ -24,6 +24,7 @@ from halsdk.core.instance import cleanup
 from halsdk.errors import (
                            CapacityError,
                            ConflictError,
+                           DamagedError,
                            ExistsError,
                            HalError,
                            HalTypeError,
@@ -63,5 +64,5 @@ __all__ = [
     "RW", "NAME_LEN", "REFERENCE_NAME_LEN",
     "HalError", "NotFoundError", "ExistsError", "HalTypeError",
     "ConflictError", "NotPermittedError", "InvalidError", "CapacityError",
-    "InstanceError", "StaleError", "LoadError",
+    "InstanceError", "DamagedError", "StaleError", "LoadError",
 ]

@@ -103,6 +103,14 @@ class InstanceError(HalError):
     """No instance, an incompatible one (ABI version), or a dead host."""
 
 
+class DamagedError(InstanceError):
+    """The instance's shared memory holds an offset, count or list link
+    that cannot be right (a stray write from a buggy component): the
+    message says "instance NAME is damaged:" and what was found where.
+    The process that finds it gets this error instead of a crash; the
+    instance should be stopped and started again."""
+
+
 class StaleError(HalError):
     """A handle whose object has been deleted."""
 
@@ -124,6 +132,7 @@ ERRNO_CLASS: dict[int, Callable[..., HalError]] = {
     22: InvalidError,           # EINVAL
     71: InstanceError,          # EPROTO
     19: InstanceError,          # ENODEV
+    117: DamagedError,          # EUCLEAN
 }
 
 
@@ -136,6 +145,7 @@ def error_for_errno(code: int, message: str, **kw: object) -> HalError:
 __all__ = [
     "CapacityError",
     "ConflictError",
+    "DamagedError",
     "ExistsError",
     "HalError",
     "HalTypeError",

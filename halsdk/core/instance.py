@@ -17,7 +17,7 @@ from types import FrameType
 from typing import TYPE_CHECKING, Any, Callable, NoReturn, Optional
 
 from halsdk.core import _core
-from halsdk.core.errors import ExistsError, InstanceError, InvalidError
+from halsdk.core.errors import ExistsError, HalError, InstanceError, InvalidError
 
 if TYPE_CHECKING:
     from halsdk.core.channel import Server
@@ -244,7 +244,11 @@ def _teardown(conn: Connection) -> None:
             except Exception as exc:  # keep tearing down
                 import sys
                 print(f"halsdk: while closing: {exc}", file=sys.stderr)
-        for comp in _core.items("component"):
+        try:
+            comps = _core.items("component")
+        except HalError:            # a damaged instance: just leave it
+            comps = []
+        for comp in comps:
             try:
                 if comp.exists and comp.pid == os.getpid():
                     _core.comp_exit(comp.id)

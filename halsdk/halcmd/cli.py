@@ -268,7 +268,7 @@ def halcmd_main(argv: Optional[list[str]] = None) -> int:
 
 def _halcmd_main(argv: Optional[list[str]] = None) -> int:
     from halsdk import Hal
-    from halsdk.errors import HalError
+    from halsdk.errors import DamagedError, HalError
     argv = sys.argv[1:] if argv is None else argv
     opts = _parse(argv, "halcmd")
     if opts.release_only:
@@ -279,13 +279,21 @@ def _halcmd_main(argv: Optional[list[str]] = None) -> int:
         return _check(opts, "halcmd")
     try:
         hal = Hal(create=False)
+    except DamagedError as exc:
+        print(f"halcmd: {exc}", file=sys.stderr)
+        return 1
     except HalError as exc:
         print(f"halcmd: no HAL instance to attach to ({exc}); "
               "start one with halrun", file=sys.stderr)
         return 1
     with hal:
-        ex = CommandRunner(hal, keep_going=opts.keep_going, script=opts.script,
-                      verbose=opts.verbose, ini=opts.ini, echo=opts.echo)
+        try:
+            ex = CommandRunner(hal, keep_going=opts.keep_going,
+                               script=opts.script, verbose=opts.verbose,
+                               ini=opts.ini, echo=opts.echo)
+        except DamagedError as exc:
+            print(f"halcmd: {exc}", file=sys.stderr)
+            return 1
         try:
             return _run(ex, opts, "halcmd")
         finally:
