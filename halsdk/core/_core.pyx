@@ -1684,7 +1684,18 @@ def shmem_new(name, int owner_id, long size) -> tuple:
     cdef long long h = hal_shmem_new(b, owner_id, size)
     if h < 0:
         check(<int>h)
-    return <size_t>hal_shmem_ptr(h), hal_shmem_size(h)
+    return shmem_place(h, name)
+
+
+cdef tuple shmem_place(long long h, name):
+    """(address, size) of a shared block's data, checked."""
+    cdef void *p = hal_shmem_ptr(h)
+    cdef long n = hal_shmem_size(h)
+    check(0)                        # data outside the heap: DamagedError
+    if p == NULL or n < 0:
+        raise _errors.NotFoundError(f"shared block '{name}' no longer "
+                                    "exists")
+    return <size_t>p, n
 
 
 def shmem_attach(name) -> tuple:
@@ -1696,7 +1707,7 @@ def shmem_attach(name) -> tuple:
     cdef long long h = hal_shmem_attach(b)
     if h < 0:
         check(<int>h)
-    return <size_t>hal_shmem_ptr(h), hal_shmem_size(h)
+    return shmem_place(h, name)
 
 
 def symbol_address(name) -> int:
