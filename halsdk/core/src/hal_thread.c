@@ -226,10 +226,17 @@ static int wait_grace(executor_t *x)
     return -1;
 }
 
+/* a thread record's executor slot is read from the segment: the
+   executor, or NULL for a slot out of range (damage) */
+static executor_t *exec_at(int slot)
+{
+    return slot >= 0 && slot < HAL_MAX_THREADS ? &execs[slot] : NULL;
+}
+
 void exec_stop(int slot)
 {
-    executor_t *x = &execs[slot];
-    if (!x->used || !x->started)
+    executor_t *x = exec_at(slot);
+    if (!x || !x->used || !x->started)
         return;
     atomic_store(&x->stop, 1);
     pthread_join(x->tid, NULL);
@@ -239,7 +246,11 @@ void exec_stop(int slot)
 
 void exec_destroy(int slot)
 {
-    executor_t *x = &execs[slot];
+    executor_t *x = exec_at(slot);
+    if (!x) {
+        hal_damaged("a thread has executor slot %d", slot);
+        return;
+    }
     if (!x->used)
         return;
     exec_stop(slot);
@@ -260,7 +271,10 @@ int exec_publish(hal_thread_t *t)
 {
     if (!hal_map.is_host)
         return 0;
-    executor_t *x = &execs[t->slot];
+    executor_t *x = exec_at(t->slot);
+    if (!x)
+        return hal_damaged("thread '%s' has executor slot %d", t->o.name,
+                           t->slot);
     if (!x->used || x->t != t)
         return hal_fail(EINVAL, "thread '%s' has no executor", t->o.name);
     if (t->nfuncts < 0 || t->nfuncts > (long)HAL_WALK_MAX)
@@ -355,8 +369,8 @@ static void *thread_main(void *arg)
 
 int exec_start(int slot, int want_rt, char *note, int notelen)
 {
-    executor_t *x = &execs[slot];
-    if (!x->used || x->started)
+    executor_t *x = exec_at(slot);
+    if (!x || !x->used || x->started)
         return 0;
     calibrate_ticks();
     atomic_store(&x->stop, 0);
@@ -489,7 +503,9 @@ int exec_stepping(void)
 /* run one thread n cycles; the simulated clock follows it */
 int exec_run_cycles(int slot, long n)
 {
-    executor_t *x = &execs[slot];
+    executor_t *x = exec_at(slot);
+    if (!x)
+        return hal_damaged("a thread has executor slot %d", slot);
     if (!x->used)
         return hal_fail(EINVAL, "no such thread executor");
     int r = begin_stepping();
