@@ -88,6 +88,12 @@ COMMANDS = [
     "save net", "save neta", "save netl", "save netla", "save param",
     "save thread", "save unconnectedinpins", "status", "status lock",
     "status mem",
+    # and changes, each undone (the walkers that change things)
+    "newsig fz-s float", "sets fz-s 1.5", "linksp fz-s pid.0.Dgain",
+    "gets fz-s", "unlinkp pid.0.Dgain", "delsig fz-s",
+    "setp pid.0.Igain 0.5", "alias pin pid.0.Igain fz-ig", "getp fz-ig",
+    "unalias pin fz-ig", "delf siggen.0.update slow",
+    "addf siggen.0.update slow",
 ]
 
 # what the Python listings touch of each object
@@ -257,20 +263,24 @@ class Host:
         from halsdk.core.instance import shm_name
         self.instance = instance
         self.path = "/dev/shm" + shm_name(instance)
-        env = dict(os.environ, HALSDK_INSTANCE=instance)
-        self.proc = subprocess.Popen(
-            [sys.executable, "-c", HOST, SETUP], stdin=subprocess.PIPE,
-            stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=cwd,
-            env=env, text=True)
+        env = dict(os.environ, HALSDK_INSTANCE=instance,
+                   PYTHONFAULTHANDLER="1")
+        # the host's messages go to a file: a pipe nobody reads would
+        # block it once full
+        self.log = os.path.join(cwd, f"host-{instance}.log")
+        with open(self.log, "w") as log:
+            self.proc = subprocess.Popen(
+                [sys.executable, "-c", HOST, SETUP], stdin=subprocess.PIPE,
+                stdout=subprocess.PIPE, stderr=log, cwd=cwd, env=env,
+                text=True)
         assert self.proc.stdout is not None
         line = self.proc.stdout.readline().strip()
         if line != "ready":
-            assert self.proc.stderr is not None
             self.proc.kill()
-            err = self.proc.stderr.read()
             self._mapped = False
             self.close()
-            raise RuntimeError(f"host did not start: {line!r}\n{err}")
+            raise RuntimeError(f"host did not start: {line!r}\n"
+                               f"{self.host_log()}")
         fd = os.open(self.path, os.O_RDWR)
         try:
             self.mm = mmap.mmap(fd, 0)
@@ -281,6 +291,10 @@ class Host:
         heap_top = struct.unpack_from(
             "<I", self.mm, self.layout.fields["heap_top"])[0]
         self.keep = bytes(self.mm[:heap_top + 4096])
+
+    def host_log(self) -> str:
+        with open(self.log, errors="replace") as f:
+            return f.read()[-3000:]
 
     def restore(self) -> None:
         """Put the bytes back (header, index and every record)."""
@@ -299,9 +313,8 @@ class Host:
             except (subprocess.TimeoutExpired, OSError):
                 self.proc.kill()
                 self.proc.wait()
-        for f in (self.proc.stdout, self.proc.stderr):
-            if f is not None:
-                f.close()
+        if self.proc.stdout is not None:
+            self.proc.stdout.close()
         try:
             os.unlink(self.path)    # the host removes it; a damaged one
         except FileNotFoundError:   # may be left: not by this campaign
@@ -443,11 +456,13 @@ def worker(count: int, seed: int, timeout: float, include_mutex: bool,
                 host.layout = read_layout(host.mm, _core.segment_layout(),
                                           include_mutex=True)
             for _ in range(count):
-                run_forked(host, random_input(rng), cmd_file, timeout,
-                           counts)
+                last = random_input(rng)
+                run_forked(host, last, cmd_file, timeout, counts)
                 if host.proc.poll() is not None:    # the host died
                     counts.crashes += 1
-                    counts.examples.append("the host died")
+                    counts.examples.append(
+                        f"the host died ({host.proc.returncode}) after "
+                        f"{last}:\n{host.host_log()}")
                     break
         finally:
             host.close()

@@ -170,6 +170,12 @@ def _thread_functs_cycle(host: Any) -> None:
     _put(host, first, first)        # the first entry's next: itself
 
 
+def _thread_slot_wild(host: Any) -> None:
+    rec = _record(host, K_THREAD, "slow")
+    _put(host, _field(host, rec, 5), 0x7FFFFFFF)    # slot: the host's
+    # executor index, used by delf/addf (the listings run both)
+
+
 def _stream_huge(host: Any) -> None:
     rec = _record(host, K_STREAM, "sampler.0")
     _put(host, _field(host, rec, 2), 100000)        # nelem
@@ -186,7 +192,7 @@ def _heap_start_wild(host: Any) -> None:
 
 CASES = [_pin_list_out_of_segment, _pin_list_cycle, _pin_signal_wild,
          _pin_owner_wild, _alias_name_wild, _thread_functs_cycle,
-         _stream_huge, _bucket_wild, _heap_start_wild]
+         _thread_slot_wild, _stream_huge, _bucket_wild, _heap_start_wild]
 
 
 @pytest.mark.slow
