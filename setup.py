@@ -36,6 +36,7 @@ core = Extension(
     sources=[
         "halsdk/core/_core.pyx",
         "halsdk/core/src/hal_core.c",
+        "halsdk/core/src/hal_check.c",
         "halsdk/core/src/hal_thread.c",
         "halsdk/core/src/hal_api.c",
         "halsdk/core/src/hal_stream.c",

@@ -24,6 +24,7 @@ from halsdk.core.instance import cleanup
 from halsdk.errors import (
                            CapacityError,
                            ConflictError,
+                           DamagedError,
                            ExistsError,
                            HalError,
                            HalTypeError,
@@ -66,6 +67,6 @@ __all__ = [
     "RW", "NAME_LEN", "REFERENCE_NAME_LEN",
     "HalError", "NotFoundError", "ExistsError", "HalTypeError",
     "ConflictError", "NotPermittedError", "InvalidError", "CapacityError",
-    "InstanceError", "StaleError", "LoadError", "TrustError",
-    "LockTimeoutError", "HostGoneError",
+    "InstanceError", "DamagedError", "StaleError", "LoadError",
+    "TrustError", "LockTimeoutError", "HostGoneError",
 ]

@@ -142,18 +142,26 @@ cdef extern from "hal_core.h" nogil:
         uint64_t num_overruns, num_underruns, sampleno
 
     ctypedef struct hal_header_t:
+        uint64_t magic
         uint32_t abi
+        uint32_t header_size
         uint64_t size
         char instance[64]
+        char mutex[1]               # pthread_mutex_t: only its place
         int32_t host_pid
         uint64_t host_start
         uint32_t serial
         uint32_t lock
         int32_t msg_level
         hoff_t heap_start, heap_top, heap_end
+        hoff_t free_class[64]
+        hoff_t free_big
         uint64_t bytes_used
-        hoff_t list_head[9]
-        int32_t count[9]
+        hoff_t list_head[10]
+        hoff_t list_tail[10]
+        int32_t count[10]
+        hoff_t buckets
+        uint32_t nbuckets
         int32_t sim_clock
         int64_t sim_time
         int32_t threads_running
@@ -165,6 +173,7 @@ cdef extern from "hal_core.h" nogil:
         hal_header_t *hdr
         long size
         int is_host
+        char name[64]
 
     hal_map_t hal_map
     int hal_loading_rt
@@ -173,6 +182,16 @@ cdef extern from "hal_core.h" nogil:
         int version
     const halsdk_api halsdk_api_table
 
+    enum:
+        HAL_NAME_SIZE, HAL_ALIGN
+    long HAL_WALK_MAX
+    void *hal_obj_at(uint64_t off, int kind)
+    void *hal_block_at(uint64_t off, uint64_t size)
+    int hal_damage_seen()
+    int hal_damage_take()
+    int hal_check_header()
+    void *hal_walk_first(int kind)
+    void *hal_walk_next(int kind, const hal_obj_t *o, long *steps)
     const char *hal_last_error()
     int hal_last_rule()
     int hal_last_kind()
@@ -276,6 +295,10 @@ cdef extern from "hal_core.h" nogil:
     void *(*hal_gil_release)() noexcept nogil
     void (*hal_gil_restore)(void *) noexcept nogil
 
+cdef extern from "<string.h>" nogil:
+    size_t strnlen(const char *s, size_t maxlen)
+
+
 cdef extern from "Python.h":
     ctypedef struct PyThreadState
     int PyGILState_Check() noexcept nogil
@@ -366,10 +389,47 @@ def error_of(int r):
 
 
 cdef int check(int r) except -1:
-    """Raise the exception of a negative core return."""
+    """Raise the exception of a negative core return, or
+    :class:`DamagedError` when the core found the instance damaged on the
+    way (whatever it returned)."""
+    if hal_damage_take():
+        raise error_of(-117)        # EUCLEAN
     if r >= 0:
         return r
     raise error_of(r)
+
+
+# ---------------------------------------------------------------- damage
+#
+# What this module reads from the segment is checked as the core checks
+# it (hal_core.h: hal_obj_at, hal_block_at): an offset that is not what
+# it should be raises DamagedError, never a crash.
+
+cdef str name_of(const hal_obj_t *o):
+    """A record's name, never read past its field."""
+    return o.name[:strnlen(o.name, HAL_NAME_SIZE)].decode("utf-8",
+                                                          "replace")
+
+
+cdef object damaged(str what):
+    inst = hal_map.name[:strnlen(hal_map.name, 64)].decode("ascii",
+                                                           "replace")
+    return _errors.DamagedError(f"instance {inst} is damaged: {what}")
+
+
+cdef void *obj_at(hoff_t off, int kind, str what,
+                  Item holder=None) except NULL:
+    """The record of that kind at off, or DamagedError naming what.
+
+    ``holder``: the object off was read from without the lock; if it was
+    deleted meanwhile (with what off leads to), that is a StaleError."""
+    cdef void *p = hal_obj_at(off, kind)
+    if p == NULL:
+        if holder is not None:
+            holder.rec()
+        raise damaged(f"{what}: offset {off} is not a "
+                      f"{KIND_WORDS.get(kind, 'object')} record")
+    return p
 
 
 cdef object _values = None
@@ -497,7 +557,7 @@ cdef class Item:
     def name(self) -> str:
         """The object's current name (its alias, if it has one)."""
         cdef hal_obj_t *o = <hal_obj_t *>self.rec()
-        return o.name.decode("utf-8", "replace")
+        return name_of(o)
 
     @property
     def exists(self) -> bool:
@@ -530,12 +590,25 @@ cdef Item make(int kind, void *p):
     it.kind = kind
     it.off = SHMOFF(p)
     it.gen = (<hal_obj_t *>p).gen
-    it._name = (<hal_obj_t *>p).name.decode("utf-8", "replace")
+    it._name = name_of(<hal_obj_t *>p)
     return it
 
 
-cdef str comp_name(hoff_t off):
-    return (<hal_obj_t *>SHMPTR(off)).name.decode("utf-8", "replace")
+cdef str comp_name(hoff_t off, Item owned):
+    return name_of(<hal_obj_t *>obj_at(
+        off, K_COMP, f"the owner of {KIND_WORDS[owned.kind]} "
+        f"'{owned._name}'", owned))
+
+
+_ITEM_DIRS = {K_PIN: (HALSDK_IN, HALSDK_OUT, HALSDK_IO),
+              K_PARAM: (HALSDK_RO, HALSDK_RW)}
+
+
+cdef int valid_type(int type, Item it) except -1:
+    if type not in TYPE_NAMES:
+        raise damaged(f"{KIND_WORDS[it.kind]} '{it._name}' has type "
+                      f"{type}")
+    return type
 
 
 cdef class ValueItem(Item):
@@ -547,30 +620,44 @@ cdef class ValueItem(Item):
     @property
     def type(self) -> int:
         """HAL type number (see :class:`halsdk.HalType`)."""
-        return (<hal_item_t *>self.rec()).type
+        return valid_type((<hal_item_t *>self.rec()).type, self)
 
     @property
     def direction(self) -> int:
         """Direction number (see :class:`halsdk.Direction`)."""
-        return (<hal_item_t *>self.rec()).dir
+        d = (<hal_item_t *>self.rec()).dir
+        if d not in _ITEM_DIRS[self.kind]:
+            raise damaged(f"{KIND_WORDS[self.kind]} '{self._name}' has "
+                          f"direction {d}")
+        return d
 
     @property
     def owner(self) -> str:
         """Name of the owning component."""
-        return comp_name((<hal_item_t *>self.rec()).comp)
+        return comp_name((<hal_item_t *>self.rec()).comp, self)
 
     @property
     def owner_id(self) -> int:
         """Id of the owning component."""
-        return (<hal_comp_t *>SHMPTR((<hal_item_t *>self.rec()).comp)).id
+        return (<hal_comp_t *>obj_at(
+            (<hal_item_t *>self.rec()).comp, K_COMP,
+            f"the owner of {KIND_WORDS[self.kind]} '{self._name}'",
+            self)).id
 
     @property
     def alias_of(self):
         """The original name while the item has an alias, else None."""
         cdef hal_item_t *it = <hal_item_t *>self.rec()
-        if it.oldname == 0:
+        cdef hoff_t off = it.oldname
+        if off == 0:
             return None
-        return (<char *>SHMPTR(it.oldname)).decode("utf-8", "replace")
+        cdef char *n = <char *>hal_block_at(off, HAL_NAME_SIZE)
+        if n == NULL or n[HAL_NAME_SIZE - 1] != 0:
+            if (<hal_item_t *>self.rec()).oldname != off:
+                return self.alias_of    # unaliased meanwhile (no lock)
+            raise damaged(f"{KIND_WORDS[self.kind]} '{self._name}': its "
+                          f"original name at offset {off} is not a name")
+        return n[:strnlen(n, HAL_NAME_SIZE)].decode("utf-8", "replace")
 
     @property
     def value(self):
@@ -603,15 +690,26 @@ cdef class Pin(ValueItem):
     """A pin: a typed endpoint of a component."""
 
     cdef void *data(self) except NULL:
-        return hal_pin_value(<hal_pin_t *>self.rec())
+        cdef void *v = hal_pin_value(<hal_pin_t *>self.rec())
+        check(0)                    # a bad signal offset: DamagedError
+        return v
 
     @property
     def signal(self):
         """The signal this pin is linked to, or None."""
         cdef hal_pin_t *p = <hal_pin_t *>self.rec()
-        if p.signal == 0:
+        cdef hoff_t so = p.signal
+        cdef void *s
+        if so == 0:
             return None
-        return make(K_SIG, SHMPTR(p.signal))
+        s = hal_obj_at(so, K_SIG)
+        if s == NULL:
+            # unlinked and deleted meanwhile (no lock here), or damage
+            self.rec()
+            if p.signal != so:
+                return self.signal
+            obj_at(so, K_SIG, f"the signal of pin '{self._name}'")
+        return make(K_SIG, s)
 
     @property
     def linked(self) -> bool:
@@ -623,7 +721,9 @@ cdef class Param(ValueItem):
     """A parameter of a component."""
 
     cdef void *data(self) except NULL:
-        return hal_param_value(<hal_param_t *>self.rec())
+        cdef void *v = hal_param_value(<hal_param_t *>self.rec())
+        check(0)                    # a bad value offset: DamagedError
+        return v
 
 
 cdef class Signal(Item):
@@ -632,7 +732,7 @@ cdef class Signal(Item):
     @property
     def type(self) -> int:
         """HAL type number (see :class:`halsdk.HalType`)."""
-        return (<hal_sig_t *>self.rec()).type
+        return valid_type((<hal_sig_t *>self.rec()).type, self)
 
     @property
     def value(self):
@@ -681,17 +781,17 @@ cdef class Signal(Item):
         """The pins linked to this signal, in creation order."""
         cdef hal_sig_t *s = <hal_sig_t *>self.rec()
         cdef hoff_t so = SHMOFF(s)
-        cdef hoff_t o
         cdef hal_pin_t *p
+        cdef long steps = 0
         out = []
         lock()
         try:
-            o = hal_map.hdr.list_head[K_PIN]
-            while o:
-                p = <hal_pin_t *>SHMPTR(o)
+            p = <hal_pin_t *>hal_walk_first(K_PIN)
+            while p != NULL:
                 if p.signal == so:
                     out.append(make(K_PIN, p))
-                o = p.o.next
+                p = <hal_pin_t *>hal_walk_next(K_PIN, &p.o, &steps)
+            check(0)                # a damaged list: DamagedError
         finally:
             hal_unlock()
         return out
@@ -743,7 +843,7 @@ cdef class Instance(Item):
     @property
     def owner(self) -> str:
         """Name of the owning component."""
-        return comp_name((<hal_inst_t *>self.rec()).comp)
+        return comp_name((<hal_inst_t *>self.rec()).comp, self)
 
 
 cdef class Function(Item):
@@ -752,12 +852,14 @@ cdef class Function(Item):
     @property
     def owner(self) -> str:
         """Name of the owning component."""
-        return comp_name((<hal_funct_t *>self.rec()).comp)
+        return comp_name((<hal_funct_t *>self.rec()).comp, self)
 
     @property
     def owner_id(self) -> int:
         """Id of the owning component."""
-        return (<hal_comp_t *>SHMPTR((<hal_funct_t *>self.rec()).comp)).id
+        return (<hal_comp_t *>obj_at(
+            (<hal_funct_t *>self.rec()).comp, K_COMP,
+            f"the owner of function '{self._name}'", self)).id
 
     @property
     def uses_fp(self) -> bool:
@@ -783,14 +885,33 @@ cdef class Function(Item):
     def time(self) -> int:
         """Last measured run time in ns (the ``.time`` pin)."""
         cdef hal_funct_t *f = <hal_funct_t *>self.rec()
-        return hal_pin_value(<hal_pin_t *>SHMPTR(f.time_pin)).s
+        return timing_pin(f.time_pin, self)
 
     @property
     def tmax(self) -> int:
         """Largest measured run time in ns (the ``.tmax`` param)."""
         cdef hal_funct_t *f = <hal_funct_t *>self.rec()
-        return (<int32_t *>hal_param_value(
-            <hal_param_t *>SHMPTR(f.tmax_param)))[0]
+        return timing_param(f.tmax_param, self)
+
+
+cdef int32_t timing_pin(hoff_t off, Item owner) except? -1:
+    """The value of a function's or thread's ``.time`` pin."""
+    cdef hal_pin_t *p = <hal_pin_t *>obj_at(
+        off, K_PIN, f"the .time pin of {KIND_WORDS[owner.kind]} "
+        f"'{owner._name}'", owner)
+    cdef hal_value_t *v = hal_pin_value(p)
+    check(0)
+    return v.s
+
+
+cdef int32_t timing_param(hoff_t off, Item owner) except? -1:
+    """The value of a function's or thread's ``.tmax`` param."""
+    cdef hal_param_t *p = <hal_param_t *>obj_at(
+        off, K_PARAM, f"the .tmax param of {KIND_WORDS[owner.kind]} "
+        f"'{owner._name}'", owner)
+    cdef int32_t *v = <int32_t *>hal_param_value(p)
+    check(0)
+    return v[0]
 
 
 cdef class Thread(Item):
@@ -830,28 +951,35 @@ cdef class Thread(Item):
     def time(self) -> int:
         """Last measured run time in ns (the ``.time`` pin)."""
         cdef hal_thread_t *t = <hal_thread_t *>self.rec()
-        return hal_pin_value(<hal_pin_t *>SHMPTR(t.time_pin)).s
+        return timing_pin(t.time_pin, self)
 
     @property
     def tmax(self) -> int:
         """Largest measured run time in ns (the ``.tmax`` param)."""
         cdef hal_thread_t *t = <hal_thread_t *>self.rec()
-        return (<int32_t *>hal_param_value(
-            <hal_param_t *>SHMPTR(t.tmax_param)))[0]
+        return timing_param(t.tmax_param, self)
 
     @property
     def functions(self) -> list:
         """Names of the functions in call order."""
         cdef hal_thread_t *t = <hal_thread_t *>self.rec()
         cdef hoff_t e
+        cdef hal_fentry_t *fe
         out = []
         lock()
         try:
             e = t.functs
             while e:
-                out.append((<hal_obj_t *>SHMPTR(
-                    (<hal_fentry_t *>SHMPTR(e)).funct)).name.decode())
-                e = (<hal_fentry_t *>SHMPTR(e)).next
+                fe = <hal_fentry_t *>hal_block_at(e, sizeof(hal_fentry_t))
+                if fe == NULL or len(out) >= t.nfuncts:
+                    raise damaged(
+                        f"thread '{self._name}': function list entry at "
+                        f"offset {e} is not an entry (or the list is "
+                        f"longer than its count {t.nfuncts})")
+                out.append(name_of(<hal_obj_t *>obj_at(
+                    fe.funct, K_FUNCT, f"a function of thread "
+                    f"'{self._name}'")))
+                e = fe.next
         finally:
             hal_unlock()
         return out
@@ -880,23 +1008,35 @@ cdef class Stream(Item):
     @property
     def owner(self) -> str:
         """Name of the owning component."""
-        return comp_name((<hal_stream_t *>self.rec()).comp)
+        return comp_name((<hal_stream_t *>self.rec()).comp, self)
+
+    cdef hal_stream_t *checked(self) except NULL:
+        """The record, its value count and types checked."""
+        cdef hal_stream_t *st = <hal_stream_t *>self.rec()
+        cdef int n = st.nelem
+        if not 1 <= n <= HAL_STREAM_MAX_ELEMS:
+            raise damaged(f"stream '{self._name}' has {n} values")
+        for i in range(n):
+            if st.types[i] not in _STREAM_LETTER:
+                raise damaged(f"stream '{self._name}': value {i} has type "
+                              f"{st.types[i]}")
+        return st
 
     @property
     def nelem(self) -> int:
         """Values per record."""
-        return (<hal_stream_t *>self.rec()).nelem
+        return self.checked().nelem
 
     @property
     def typestring(self) -> str:
         """One letter per value: f b s u l k."""
-        cdef hal_stream_t *st = <hal_stream_t *>self.rec()
+        cdef hal_stream_t *st = self.checked()
         return "".join(_STREAM_LETTER[st.types[i]] for i in range(st.nelem))
 
     @property
     def types(self) -> list:
         """Type numbers of the values (BIT, FLOAT, ...)."""
-        cdef hal_stream_t *st = <hal_stream_t *>self.rec()
+        cdef hal_stream_t *st = self.checked()
         return [st.types[i] for i in range(st.nelem)]
 
     @property
@@ -931,7 +1071,7 @@ cdef class Stream(Item):
 
     def write(self, values) -> bool:
         """Append one record; False (and one more overrun) when full."""
-        cdef hal_stream_t *st = <hal_stream_t *>self.rec()
+        cdef hal_stream_t *st = self.checked()
         cdef int n = st.nelem
         cdef halsdk_value_t rec[256]
         vals = list(values)
@@ -953,7 +1093,7 @@ cdef class Stream(Item):
     def read(self):
         """(sample number, tuple of values) of the oldest record, or None
         (and one more underrun) when the FIFO is empty."""
-        cdef hal_stream_t *st = <hal_stream_t *>self.rec()
+        cdef hal_stream_t *st = self.checked()
         cdef halsdk_value_t rec[256]
         cdef uint64_t sn = 0
         cdef int r = hal_stream_read(self.handle(), rec, &sn)
@@ -967,7 +1107,7 @@ cdef class Stream(Item):
         """NumPy dtype of a record: field ``sample`` then one per value
         (named by ``names``, default ``v0``, ``v1``, ...)."""
         import numpy as np
-        cdef hal_stream_t *st = <hal_stream_t *>self.rec()
+        cdef hal_stream_t *st = self.checked()
         n = st.nelem
         if names is None:
             names = [f"v{i}" for i in range(n)]
@@ -1114,7 +1254,8 @@ def info() -> dict:
     need_instance()
     cdef hal_header_t *h = hal_map.hdr
     return {
-        "instance": h.instance.decode(),
+        "instance": hal_map.name[:strnlen(hal_map.name, 64)].decode(
+            "ascii", "replace"),
         "size": h.size,
         "abi": h.abi,
         "host_pid": h.host_pid,
@@ -1131,6 +1272,36 @@ def info() -> dict:
         "recovered": h.recovered,
         "msg_level": h.msg_level,
         "lock_holder": h.lock_holder,
+    }
+
+
+def segment_layout() -> dict:
+    """Where the header fields and the record heads lie in a segment of
+    this ABI (byte offsets and sizes), for tools and tests that look at
+    or damage a segment on purpose (tests/core/test_segment_fuzz.py)."""
+    cdef hal_header_t h
+    cdef hal_obj_t o
+    cdef char *b = <char *>&h
+    cdef char *ob = <char *>&o
+
+    return {
+        "header_size": sizeof(hal_header_t),
+        "mutex": (<char *>&h.mutex - b, sizeof(h.mutex)),
+        "instance": (<char *>&h.instance - b, 64),
+        "heap_start": <char *>&h.heap_start - b,
+        "heap_top": <char *>&h.heap_top - b,
+        "heap_end": <char *>&h.heap_end - b,
+        "free_class": <char *>&h.free_class - b,
+        "free_big": <char *>&h.free_big - b,
+        "list_head": <char *>&h.list_head - b,
+        "list_tail": <char *>&h.list_tail - b,
+        "count": <char *>&h.count - b,
+        "buckets": <char *>&h.buckets - b,
+        "nbuckets": <char *>&h.nbuckets - b,
+        "nkinds": K_NKINDS,
+        "block_header": 16,
+        "obj_name": <char *>&o.name - ob,
+        "name_size": HAL_NAME_SIZE,
     }
 
 
@@ -1185,6 +1356,7 @@ def find(str kind, name):
     lock()
     try:
         p = hal_find(k, b)
+        check(0)                    # a damaged index: DamagedError
         return make(k, p) if p != NULL else None
     finally:
         hal_unlock()
@@ -1194,16 +1366,20 @@ def items(str kind):
     """Handles of every object of a kind, in creation order."""
     need_instance()
     cdef int k = _KIND_BY_WORD[kind]
-    cdef hoff_t o
     cdef hal_obj_t *obj
+    cdef long steps = 0
     out = []
     lock()
     try:
-        o = hal_map.hdr.list_head[k]
-        while o:
-            obj = <hal_obj_t *>SHMPTR(o)
+        check(hal_check_header())
+        obj = <hal_obj_t *>hal_walk_first(k)
+        while obj != NULL:
+            if len(out) >= hal_map.hdr.count[k]:
+                raise damaged(f"the {kind} list is longer than its count "
+                              f"{hal_map.hdr.count[k]}")
             out.append(make(k, obj))
-            o = obj.next
+            obj = <hal_obj_t *>hal_walk_next(k, obj, &steps)
+        check(0)                    # a damaged list: DamagedError
     finally:
         hal_unlock()
     return out
@@ -1361,6 +1537,7 @@ def comp_by_id(int id):
     lock()
     try:
         c = hal_comp_by_id(id)
+        check(0)
         return make(K_COMP, c) if c != NULL else None
     finally:
         hal_unlock()
@@ -1738,7 +1915,18 @@ def shmem_new(name, int owner_id, long size) -> tuple:
     cdef long long h = hal_shmem_new(b, owner_id, size)
     if h < 0:
         check(<int>h)
-    return <size_t>hal_shmem_ptr(h), hal_shmem_size(h)
+    return shmem_place(h, name)
+
+
+cdef tuple shmem_place(long long h, name):
+    """(address, size) of a shared block's data, checked."""
+    cdef void *p = hal_shmem_ptr(h)
+    cdef long n = hal_shmem_size(h)
+    check(0)                        # data outside the heap: DamagedError
+    if p == NULL or n < 0:
+        raise _errors.NotFoundError(f"shared block '{name}' no longer "
+                                    "exists")
+    return <size_t>p, n
 
 
 def shmem_attach(name) -> tuple:
@@ -1750,7 +1938,7 @@ def shmem_attach(name) -> tuple:
     cdef long long h = hal_shmem_attach(b)
     if h < 0:
         check(<int>h)
-    return <size_t>hal_shmem_ptr(h), hal_shmem_size(h)
+    return shmem_place(h, name)
 
 
 def symbol_address(name) -> int:

@@ -108,6 +108,8 @@ class TrustError(InstanceError):
     does not trust: not owned by the effective user, the wrong mode, more
     than one hard link, or a symbolic link.  The message names the check
     that failed, the file and its owner."""
+
+
 class LockTimeoutError(InstanceError, TimeoutError):
     """The instance lock could not be taken within the lock timeout
     (``HALSDK_LOCK_TIMEOUT``, default 5 s): the message names the
@@ -118,6 +120,14 @@ class HostGoneError(InstanceError, ConnectionError):
     """The host of the instance cannot be reached or went away during a
     request (refused, reset or closed channel, no answer in time); the
     message names the instance."""
+
+
+class DamagedError(InstanceError):
+    """The instance's shared memory holds an offset, count or list link
+    that cannot be right (a stray write from a buggy component): the
+    message says "instance NAME is damaged:" and what was found where.
+    The process that finds it gets this error instead of a crash; the
+    instance should be stopped and started again."""
 
 
 class StaleError(HalError):
@@ -143,6 +153,7 @@ ERRNO_CLASS: dict[int, Callable[..., HalError]] = {
     19: InstanceError,          # ENODEV
     13: TrustError,             # EACCES: the trust checks of a segment
     110: LockTimeoutError,      # ETIMEDOUT
+    117: DamagedError,          # EUCLEAN
 }
 
 
@@ -155,6 +166,7 @@ def error_for_errno(code: int, message: str, **kw: object) -> HalError:
 __all__ = [
     "CapacityError",
     "ConflictError",
+    "DamagedError",
     "ExistsError",
     "HalError",
     "HalTypeError",

@@ -269,6 +269,7 @@ def halcmd_main(argv: Optional[list[str]] = None) -> int:
 def _halcmd_main(argv: Optional[list[str]] = None) -> int:
     from halsdk import Hal
     from halsdk.errors import (
+        DamagedError,
         HalError,
         HostGoneError,
         InvalidError,
@@ -285,7 +286,7 @@ def _halcmd_main(argv: Optional[list[str]] = None) -> int:
         return _check(opts, "halcmd")
     try:
         hal = Hal(create=False)
-    except (TrustError, InvalidError, LockTimeoutError,
+    except (TrustError, DamagedError, InvalidError, LockTimeoutError,
             HostGoneError) as exc:
         print(f"halcmd: {exc}", file=sys.stderr)
         return 1

@@ -160,10 +160,12 @@ class CommandRunner:
         self.comp_id = comp.id
 
     def unregister(self) -> None:
-        if self.component is not None:
-            self.component.exit()
-            self.component = None
-        self.comp_id = None
+        comp, self.component, self.comp_id = self.component, None, None
+        if comp is not None:
+            try:
+                comp.exit()
+            except HalError as exc:     # a damaged instance: say so
+                self.error(str(exc))
 
     # ------------------------------------------------------------ running
 

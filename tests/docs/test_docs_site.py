@@ -27,7 +27,8 @@ PAGES = ["index", "concepts", "tutorial", "components", "halcmd", "runtests",
          "motion", "running", "machine", "tooltable", "gcode", "drivers",
          "driver-realtime", "driver-sim-io", "driver-cia402", "driver-whb04b",
          "driver-mqtt", "driver-candbc", "driver-mb2hal", "homing",
-         "kinematics", "architecture", "design", "compat", "benchmarks"]
+         "kinematics", "architecture", "design", "compat", "benchmarks",
+         "reliability"]
 
 
 @pytest.fixture(scope="module")

@@ -27,13 +27,18 @@
 
 hal_map_t hal_map;
 
+/* each record of a kind's list, checked (hal_walk_first/next); the body
+   may delete var */
+#define FOR_EACH(kind, type, var)                                         \
+    for (long var##_n = 0; var##_n == 0; var##_n = -1)                    \
+        for (type *var = hal_walk_first(kind), *var##_nx = NULL;          \
+             var && ((var##_nx = hal_walk_next(kind, &var->o,             \
+                                               &var##_n)), 1);            \
+             var = var##_nx)
+
 static const char *kind_word(int kind)
 {
-    static const char *const words[K_NKINDS] = {
-        "object", "component", "instance", "pin", "param", "signal",
-        "function", "thread", "stream", "shared block"
-    };
-    return kind > 0 && kind < K_NKINDS ? words[kind] : "object";
+    return hal_kind_word(kind);
 }
 
 static __thread char errbuf[512];
@@ -43,6 +48,8 @@ static int cur_owner;           /* last comp/inst created here: hal_malloc */
 
 int hal_fail(int err, const char *fmt, ...)
 {
+    if (hal_damage_seen())      /* the damage is what went wrong */
+        return -EUCLEAN;
     va_list ap;
     va_start(ap, fmt);
     vsnprintf(errbuf, sizeof(errbuf), fmt, ap);
@@ -57,6 +64,8 @@ int hal_rule(int r, int rule, int kind, const char *name0,
              const char *name1, const char *name2)
 {
     const char *names[3] = {name0, name1, name2};
+    if (hal_damage_seen())
+        return r;
     err_rule = rule;
     err_kind = kind;
     for (int k = 0; k < 3; k++)
@@ -277,6 +286,7 @@ int hal_lock(void)
     hal_header_t *h = hal_map.hdr;
     if (!h)
         return hal_fail(ENODEV, "no HAL instance is attached");
+    hal_damage_take();          /* each operation reports its own */
     /* A holder may be waiting for a thread cycle that runs a Python
        function: never wait for the mutex with the GIL held.  A holder
        that is stopped (SIGSTOP) or stuck must not block this process for
@@ -341,22 +351,51 @@ static inline uint32_t round16(long n)
     return (uint32_t)((n + 15) & ~15L);
 }
 
+/* the free block at off of a free list (exact size need if class
+   cls < HAL_NCLASSES), or NULL with the damage reported */
+static hal_block_t *free_block_at(hoff_t off, uint32_t need, uint32_t cls)
+{
+    hal_block_t *b = NULL;
+    if (hal_off_ok(off, sizeof(hal_block_t), HAL_ALIGN)) {
+        b = SHMPTR(off);
+        if (b->magic != HAL_BLOCK_FREE ||
+            b->size > hal_map.heap_end - off - sizeof(hal_block_t) ||
+            (cls < HAL_NCLASSES && b->size != need) || (b->size & 15) ||
+            (b->next && !hal_off_ok(b->next, sizeof(hal_block_t),
+                                    HAL_ALIGN)))
+            b = NULL;
+    }
+    if (!b)
+        hal_damaged("free list %u has offset %u, not a free block", cls,
+                    off);
+    return b;
+}
+
 void *hal_alloc(long size, hoff_t owner)
 {
     hal_header_t *h = hal_map.hdr;
-    if (size <= 0 || size > (long)(h->heap_end - h->heap_start))
+    if (size <= 0 || size > (long)(hal_map.heap_end - hal_map.heap_start))
         return NULL;
     uint32_t need = round16(size);
     hal_block_t *b = NULL;
     uint32_t cls = need / 16;
     if (cls < HAL_NCLASSES && h->free_class[cls]) {
-        b = SHMPTR(h->free_class[cls]);
+        b = free_block_at(h->free_class[cls], need, cls);
+        if (!b)
+            return NULL;
         h->free_class[cls] = b->next;
     } else if (cls >= HAL_NCLASSES) {
         /* first fit among the big free blocks */
         hoff_t *link = &h->free_big;
+        long steps = 0;
         while (*link) {
-            hal_block_t *c = SHMPTR(*link);
+            hal_block_t *c = free_block_at(*link, 0, cls);
+            if (!c || ++steps > (long)HAL_WALK_MAX) {
+                if (c)
+                    hal_damaged("the free list of big blocks does not "
+                                "end");
+                return NULL;
+            }
             if (c->size >= need) {
                 *link = c->next;
                 b = c;
@@ -367,7 +406,13 @@ void *hal_alloc(long size, hoff_t owner)
     }
     if (!b) {
         uint64_t total = sizeof(hal_block_t) + need;
-        if ((uint64_t)h->heap_top + total > h->heap_end)
+        if (h->heap_top < hal_map.heap_start ||
+            h->heap_top > hal_map.heap_end || (h->heap_top & 15)) {
+            hal_damaged("heap top %u is outside the heap %u..%u",
+                        h->heap_top, hal_map.heap_start, hal_map.heap_end);
+            return NULL;
+        }
+        if ((uint64_t)h->heap_top + total > hal_map.heap_end)
             return NULL;
         b = SHMPTR(h->heap_top);
         h->heap_top += (hoff_t)total;
@@ -387,9 +432,11 @@ void hal_free(void *p)
     hal_header_t *h = hal_map.hdr;
     if (!p)
         return;
-    hal_block_t *b = (hal_block_t *)p - 1;
-    if (b->magic != HAL_BLOCK_USED)
+    if (!hal_block_at(SHMOFF(p), 0)) {
+        hal_damaged("offset %u to free is not a used block", SHMOFF(p));
         return;
+    }
+    hal_block_t *b = (hal_block_t *)p - 1;
     b->magic = HAL_BLOCK_FREE;
     h->bytes_used -= sizeof(hal_block_t) + b->size;
     uint32_t cls = b->size / 16;
@@ -419,7 +466,15 @@ static void *alloc_for(hoff_t owner_off, long size)
 
 static void free_owned(hoff_t *head)
 {
+    long steps = 0;
     while (*head) {
+        if (!hal_block_at((uint64_t)*head + sizeof(hal_block_t), 0) ||
+            ++steps > (long)HAL_WALK_MAX) {
+            hal_damaged("memory list of a component: offset %u is not a "
+                        "used block", *head);
+            *head = 0;          /* drop (leak) the rest */
+            return;
+        }
         hal_block_t *b = SHMPTR(*head);
         *head = b->next;
         hal_free(b + 1);
@@ -448,18 +503,24 @@ static uint32_t name_hash(int space, const char *name)
     return x;
 }
 
+/* the name index where attach checked it is (hal_map) */
 static hoff_t *bucket(uint32_t hash)
 {
-    hal_header_t *h = hal_map.hdr;
-    hoff_t *b = SHMPTR(h->buckets);
-    return &b[hash & (h->nbuckets - 1)];
+    hoff_t *b = SHMPTR(hal_map.buckets);
+    return &b[hash & (hal_map.nbuckets - 1)];
 }
 
 static void *find_in_space(int space, const char *name)
 {
     uint32_t x = name_hash(space, name);
+    long steps = 0;
     for (hoff_t o = *bucket(x); o;) {
-        hal_obj_t *obj = SHMPTR(o);
+        hal_obj_t *obj = hal_obj_at(o, K_NONE);
+        if (!obj || ++steps > (long)HAL_WALK_MAX) {
+            hal_damaged("name index chain of '%.40s': offset %u is not a "
+                        "record%s", name, o, obj ? " (a cycle)" : "");
+            return NULL;
+        }
         if (obj->hash == x && name_space(obj->kind) == space &&
             strcmp(obj->name, name) == 0)
             return obj;
@@ -468,18 +529,35 @@ static void *find_in_space(int space, const char *name)
     return NULL;
 }
 
+/* the original name of an aliased item, or NULL with the damage
+   reported */
+static char *oldname_of(hal_item_t *it)
+{
+    char *n = hal_block_at(it->oldname, HAL_NAME_SIZE);
+    if (!n || n[HAL_NAME_SIZE - 1] != 0) {
+        hal_damaged("%s '%s': original name at offset %u is not a name",
+                    kind_word(it->o.kind), it->o.name, it->oldname);
+        return NULL;
+    }
+    return n;
+}
+
 void *hal_find(int kind, const char *name)
 {
     hal_obj_t *o = find_in_space(name_space(kind), name);
-    if (o && o->kind == kind)
-        return o;
+    if (o && o->kind == kind) {
+        if (hal_obj_at(SHMOFF(o), kind))    /* its block holds the kind */
+            return o;
+        hal_damaged("%s '%s' at offset %u is too small for its kind",
+                    kind_word(kind), name, SHMOFF(o));
+        return NULL;
+    }
     /* an aliased pin or param still answers to its original name */
     if ((kind == K_PIN || kind == K_PARAM) && hal_map.hdr->naliases > 0) {
-        for (hoff_t x = hal_map.hdr->list_head[kind]; x;) {
-            hal_item_t *it = SHMPTR(x);
-            if (it->oldname && strcmp(SHMPTR(it->oldname), name) == 0)
+        FOR_EACH(kind, hal_item_t, it) {
+            const char *old = it->oldname ? oldname_of(it) : NULL;
+            if (old && strcmp(old, name) == 0)
                 return it;
-            x = it->o.next;
         }
     }
     return NULL;
@@ -496,12 +574,19 @@ static void index_insert(hal_obj_t *o)
 static void index_remove(hal_obj_t *o)
 {
     hoff_t *link = bucket(o->hash), me = SHMOFF(o);
+    long steps = 0;
     while (*link) {
         if (*link == me) {
             *link = o->hnext;
             break;
         }
-        link = &((hal_obj_t *)SHMPTR(*link))->hnext;
+        hal_obj_t *x = hal_obj_at(*link, K_NONE);
+        if (!x || ++steps > (long)HAL_WALK_MAX) {
+            hal_damaged("name index chain of '%.40s': offset %u is not a "
+                        "record", o->name, *link);
+            break;
+        }
+        link = &x->hnext;
     }
     o->hnext = 0;
 }
@@ -571,10 +656,16 @@ static void obj_publish(hal_obj_t *o)
     hoff_t me = SHMOFF(o);
     o->next = 0;
     o->prev = h->list_tail[o->kind];
-    if (o->prev)
-        ((hal_obj_t *)SHMPTR(o->prev))->next = me;
-    else
+    hal_obj_t *prev = o->prev ? hal_obj_get(o->prev, o->kind, "the end of "
+                                            "the list of",
+                                            kind_word(o->kind))
+                              : NULL;
+    if (prev)
+        prev->next = me;
+    else if (!o->prev)
         h->list_head[o->kind] = me;
+    else
+        o->prev = 0;
     h->list_tail[o->kind] = me;
     index_insert(o);
     h->count[o->kind]++;
@@ -585,13 +676,17 @@ static void obj_delete(hal_obj_t *o)
 {
     hal_header_t *h = hal_map.hdr;
     index_remove(o);
-    if (o->prev)
-        ((hal_obj_t *)SHMPTR(o->prev))->next = o->next;
-    else
+    hal_obj_t *prev = o->prev ? hal_obj_get(o->prev, o->kind, "the record "
+                                            "before", o->name) : NULL;
+    hal_obj_t *next = o->next ? hal_obj_get(o->next, o->kind, "the record "
+                                            "after", o->name) : NULL;
+    if (prev)
+        prev->next = o->next;
+    else if (!o->prev)
         h->list_head[o->kind] = o->next;
-    if (o->next)
-        ((hal_obj_t *)SHMPTR(o->next))->prev = o->prev;
-    else
+    if (next)
+        next->prev = o->prev;
+    else if (!o->next)
         h->list_tail[o->kind] = o->prev;
     h->count[o->kind]--;
     h->serial++;
@@ -615,14 +710,6 @@ void hal_obj_delete(hal_obj_t *o)
 {
     obj_delete(o);
 }
-
-#define FOR_EACH(kind, type, var)                                         \
-    for (type *var = hal_map.hdr->list_head[kind]                         \
-                         ? SHMPTR(hal_map.hdr->list_head[kind]) : NULL,   \
-              *var##_nx = NULL;                                           \
-         var && ((var##_nx = var->o.next ? SHMPTR(var->o.next) : NULL),   \
-                 1);                                                      \
-         var = var##_nx)
 
 hal_comp_t *hal_comp_by_id(int id)
 {
@@ -649,7 +736,8 @@ static int resolve_owner(int id, hal_comp_t **comp, hal_inst_t **inst,
     if (!*comp) {
         *inst = hal_inst_by_id(id);
         if (*inst)
-            *comp = SHMPTR((*inst)->comp);
+            *comp = hal_obj_get((*inst)->comp, K_COMP, "the owner of "
+                                "instance", (*inst)->o.name);
     }
     if (!*comp)
         return hal_rule(hal_fail(EINVAL, "%s '%s': no component with id "
@@ -798,9 +886,11 @@ void *hal_malloc_owned(long size, int owner_id)
     hoff_t owner = 0;
     hal_comp_t *c = hal_comp_by_id(owner_id);
     hal_inst_t *i = c ? NULL : hal_inst_by_id(owner_id);
+    hal_comp_t *ic = i ? hal_obj_get(i->comp, K_COMP, "the owner of "
+                                     "instance", i->o.name) : NULL;
     if (c && c->pid == getpid())
         owner = SHMOFF(c);
-    else if (i && ((hal_comp_t *)SHMPTR(i->comp))->pid == getpid())
+    else if (ic && ic->pid == getpid())
         owner = SHMOFF(i);
     void *p = alloc_for(owner, size);
     if (!p)
@@ -821,22 +911,44 @@ void *hal_malloc_current(long size)
 
 static void write_cell(hal_pin_t *pin, volatile void *target)
 {
-    hal_comp_t *c = SHMPTR(pin->comp);
+    hal_comp_t *c = hal_obj_get(pin->comp, K_COMP, "the owner of pin",
+                                pin->o.name);
+    if (!c)
+        return;
+    if (!hal_off_ok(pin->ptr_cell, sizeof(uint64_t), 1)) {
+        hal_damaged("pin '%s': pointer cell offset %u is outside the heap",
+                    pin->o.name, pin->ptr_cell);
+        return;
+    }
     uint64_t addr = c->base + (uint64_t)((const char *)target - hal_map.base);
     __atomic_store_n((uint64_t *)SHMPTR(pin->ptr_cell), addr,
                      __ATOMIC_RELEASE);
 }
 
+/* without the lock: a signal deleted meanwhile still has its bytes, so
+   only the bounds are checked */
 hal_value_t *hal_pin_value(hal_pin_t *pin)
 {
-    if (pin->signal)
-        return &((hal_sig_t *)SHMPTR(pin->signal))->value;
+    hoff_t so = pin->signal;
+    if (!so)
+        return &pin->dummy;
+    if (hal_off_ok(so, sizeof(hal_sig_t), HAL_ALIGN))
+        return &((hal_sig_t *)SHMPTR(so))->value;
+    hal_damaged("pin '%s': signal offset %u is outside the heap",
+                pin->o.name, so);
     return &pin->dummy;
 }
 
+/* a bad offset gives (and reports) a scratch value, never NULL: realtime
+   captures read through this */
 void *hal_param_value(hal_param_t *param)
 {
-    return SHMPTR(param->data);
+    static hal_value_t scratch;
+    if (hal_off_ok(param->data, sizeof(hal_value_t), 1))
+        return SHMPTR(param->data);
+    hal_damaged("param '%s': value offset %u is outside the heap",
+                param->o.name, param->data);
+    return &scratch;
 }
 
 /* the record of a pin or param, published; lock held.  `where` is the
@@ -976,7 +1088,11 @@ int hal_unalias(int kind, const char *alias)
         r = fail_not_found(kind, alias);
         goto out;
     }
-    char *orig = SHMPTR(*oldname);
+    char *orig = oldname_of((hal_item_t *)o);
+    if (!orig) {
+        r = -EUCLEAN;
+        goto out;
+    }
     if (find_in_space(K_PIN, orig)) {
         r = hal_rule(hal_fail(EEXIST, "cannot unalias '%s': its original "
                               "name '%s' is in use", alias, orig),
@@ -1033,7 +1149,13 @@ int hal_signal_new(const char *name, int type)
 
 static void unlink_locked(hal_pin_t *p)
 {
-    hal_sig_t *s = SHMPTR(p->signal);
+    hal_sig_t *s = hal_obj_get(p->signal, K_SIG, "the signal of pin",
+                               p->o.name);
+    if (!s) {
+        write_cell(p, &p->dummy);
+        p->signal = 0;
+        return;
+    }
     /* the pin keeps the last value it saw */
     p->dummy.lu = s->value.lu;
     write_cell(p, &p->dummy);
@@ -1053,7 +1175,9 @@ static void item_delete(hal_item_t *it)
     if (it->o.kind == K_PIN && ((hal_pin_t *)it)->signal)
         unlink_locked((hal_pin_t *)it);
     if (it->oldname) {
-        hal_free(SHMPTR(it->oldname));
+        char *old = oldname_of(it);
+        if (old)
+            hal_free(old);
         hal_map.hdr->naliases--;
     }
     obj_delete(&it->o);
@@ -1103,7 +1227,11 @@ static int link_check(hal_pin_t *p, const char *sig_name, int type,
 {
     const char *pin_name = p->o.name;
     if (p->signal) {
-        const char *cur = ((hal_sig_t *)SHMPTR(p->signal))->o.name;
+        hal_sig_t *cs = hal_obj_get(p->signal, K_SIG, "the signal of pin",
+                                    pin_name);
+        if (!cs)
+            return -EUCLEAN;
+        const char *cur = cs->o.name;
         return hal_rule(hal_fail(EBUSY, "Pin '%s' was already linked to "
                                  "signal '%s'", pin_name, cur),
                         HAL_RULE_PIN_LINKED, K_PIN, pin_name, cur,
@@ -1316,11 +1444,20 @@ int hal_check_settable(const hal_obj_t *o, int flags)
                                      o->name),
                             HAL_RULE_WRITE_OUTPUT, K_PIN, o->name, NULL,
                             NULL);
-        if (p->signal)
+        hoff_t so = p->signal;
+        if (so) {
+            /* no lock here: unlinked and deleted meanwhile is no damage */
+            hal_sig_t *s = hal_obj_at(so, K_SIG);
+            if (!s && p->signal != so)
+                return hal_check_settable(o, flags);
+            if (!s)
+                return hal_damaged("pin '%s': signal offset %u is not a "
+                                   "signal record", o->name, so);
             return hal_rule(hal_fail(EBUSY, "pin '%s' is connected to a "
                                      "signal", o->name),
                             HAL_RULE_PIN_CONNECTED, K_PIN, o->name,
-                            ((hal_sig_t *)SHMPTR(p->signal))->o.name, NULL);
+                            s->o.name, NULL);
+        }
     } else if (o->kind == K_PARAM) {
         if (((const hal_param_t *)o)->dir == HALSDK_RO)
             return hal_rule(hal_fail(EPERM, "param '%s' is not writable",
@@ -1545,16 +1682,37 @@ out:
     return r;
 }
 
+/* the entry at off of thread t's function list, or NULL with the damage
+   reported; steps counts the walk */
+static hal_fentry_t *fentry_at(hal_thread_t *t, hoff_t off, long *steps)
+{
+    if (!hal_block_at(off, sizeof(hal_fentry_t)) ||
+        ++*steps > (long)t->nfuncts + 1 || *steps > (long)HAL_WALK_MAX) {
+        hal_damaged("thread '%s': function list entry at offset %u is "
+                    "not an entry%s", t->o.name, off,
+                    *steps > 1 ? " (or the list is longer than its count)"
+                               : "");
+        return NULL;
+    }
+    return SHMPTR(off);
+}
+
 /* remove every entry of a function from a thread's list */
 static int drop_entries(hal_thread_t *t, hoff_t fo)
 {
     int n = 0;
     hoff_t *link = &t->functs;
+    long steps = 0;
     while (*link) {
-        hal_fentry_t *e = SHMPTR(*link);
+        hal_fentry_t *e = fentry_at(t, *link, &steps);
+        if (!e) {
+            *link = 0;          /* drop (leak) the rest of the list */
+            break;
+        }
         if (fo == 0 || e->funct == fo) {
-            hal_funct_t *f = SHMPTR(e->funct);
-            f->users--;
+            hal_funct_t *f = hal_obj_at(e->funct, K_FUNCT);
+            if (f)
+                f->users--;
             *link = e->next;
             hal_free(e);
             t->nfuncts--;
@@ -1570,7 +1728,8 @@ static void thread_delete_locked(hal_thread_t *t)
 {
     exec_destroy(t->slot);
     drop_entries(t, 0);
-    hal_comp_t *c = SHMPTR(t->comp);
+    hal_comp_t *c = hal_obj_get(t->comp, K_COMP, "the component of thread",
+                                t->o.name);
     hoff_t co = t->comp;
     FOR_EACH(K_PIN, hal_item_t, it)
         if (it->comp == co)
@@ -1578,8 +1737,10 @@ static void thread_delete_locked(hal_thread_t *t)
     FOR_EACH(K_PARAM, hal_item_t, it)
         if (it->comp == co)
             item_delete(it);
-    free_owned(&c->mem);
-    obj_delete(&c->o);
+    if (c) {
+        free_owned(&c->mem);
+        obj_delete(&c->o);
+    }
     obj_delete(&t->o);
 }
 
@@ -1643,8 +1804,16 @@ int hal_addf(const char *funct, const char *thread, int position)
     e->funct = SHMOFF(f);
     int index = position > 0 ? position - 1 : t->nfuncts + 1 + position;
     hoff_t *link = &t->functs;
-    for (int k = 0; k < index; k++)
-        link = &((hal_fentry_t *)SHMPTR(*link))->next;
+    long steps = 0;
+    for (int k = 0; k < index; k++) {
+        hal_fentry_t *x = fentry_at(t, *link, &steps);
+        if (!x) {
+            hal_free(e);
+            r = -EUCLEAN;
+            goto out;
+        }
+        link = &x->next;
+    }
     e->next = *link;
     *link = SHMOFF(e);
     t->nfuncts++;
@@ -1688,8 +1857,17 @@ int hal_delf(const char *funct, const char *thread)
         goto out;
     /* remove the first entry only, as the reference does */
     hoff_t *link = &t->functs, fo = SHMOFF(f);
-    while (*link && ((hal_fentry_t *)SHMPTR(*link))->funct != fo)
-        link = &((hal_fentry_t *)SHMPTR(*link))->next;
+    long steps = 0;
+    while (*link) {
+        hal_fentry_t *x = fentry_at(t, *link, &steps);
+        if (!x) {
+            r = -EUCLEAN;
+            goto out;
+        }
+        if (x->funct == fo)
+            break;
+        link = &x->next;
+    }
     if (!*link) {
         r = hal_rule(hal_fail(ENOENT, "function '%s' is not in thread '%s'",
                               funct, thread),
@@ -1744,7 +1922,7 @@ void *hal_handle_get(long long handle, int kind, size_t size)
         return NULL;
     hoff_t off = (hoff_t)(handle & 0xffffffffLL);
     uint32_t gen = (uint32_t)((unsigned long long)handle >> 32);
-    if (off < h->heap_start || off + size > h->heap_end)
+    if (!hal_off_ok(off, size, HAL_ALIGN))
         return NULL;
     hal_obj_t *o = SHMPTR(off);
     if (__atomic_load_n(&o->kind, __ATOMIC_ACQUIRE) != kind ||
@@ -1775,13 +1953,9 @@ _Static_assert(offsetof(hal_stream_t, comp) == offsetof(hal_owned_t, comp)
 
 void hal_delete_owned(int kind, hoff_t comp, hoff_t inst)
 {
-    hal_header_t *h = hal_map.hdr;
-    for (hoff_t off = h->list_head[kind]; off;) {
-        hal_owned_t *o = SHMPTR(off);
-        off = o->o.next;
+    FOR_EACH(kind, hal_owned_t, o)
         if (o->comp == comp && (!inst || o->inst == inst))
             hal_obj_delete(&o->o);
-    }
 }
 
 int hal_owner(int owner_id, const char *what, hoff_t *comp, hoff_t *inst)
@@ -1792,7 +1966,8 @@ int hal_owner(int owner_id, const char *what, hoff_t *comp, hoff_t *inst)
         hal_inst_t *i = hal_inst_by_id(owner_id);
         if (i) {
             *inst = SHMOFF(i);
-            c = SHMPTR(i->comp);
+            c = hal_obj_get(i->comp, K_COMP, "the owner of instance",
+                            i->o.name);
         }
     }
     if (!c)
@@ -1815,10 +1990,12 @@ int hal_inst_delete(const char *name)
         hal_unlock();
         return fail_not_found(K_INST, name);
     }
-    hal_comp_t *c = SHMPTR(i->comp);
+    hal_comp_t *c = hal_obj_get(i->comp, K_COMP, "the owner of instance",
+                                i->o.name);
     delete_items_of(i->comp, SHMOFF(i));
     free_owned(&i->mem);
-    c->ninst--;
+    if (c)
+        c->ninst--;
     obj_delete(&i->o);
     hal_unlock();
     return 0;
@@ -1894,8 +2071,9 @@ static int fsck_kind(int kind, char *rep, int len, int *bad)
     int n = 0;
     hoff_t prev = 0;
     for (hoff_t o = h->list_head[kind]; o;) {
-        hal_obj_t *obj = SHMPTR(o);
-        if (o >= h->heap_top || obj->kind != kind || obj->prev != prev) {
+        hal_obj_t *obj = hal_obj_at(o, kind);
+        if (!obj || o >= h->heap_top || obj->prev != prev ||
+            n >= (long)HAL_WALK_MAX) {
             note(rep, len, "%s list broken at offset %u",
                      kind_word(kind), o);
             (*bad)++;
@@ -1952,13 +2130,6 @@ static hoff_t *sorted_offsets(int kind, long n)
         offs[k++] = o;
     qsort(offs, k, sizeof(hoff_t), cmp_hoff);
     return offs;
-}
-
-/* an offset of a record of size bytes inside the heap */
-static int in_heap(hoff_t off, size_t size)
-{
-    hal_header_t *h = hal_map.hdr;
-    return off >= h->heap_start && (uint64_t)off + size <= h->heap_top;
 }
 
 /*
@@ -2023,8 +2194,7 @@ int hal_check_consistency(char *rep, int len)
     FOR_EACH(K_PIN, hal_pin_t, p) {
         if (np++ >= n[K_PIN])
             break;
-        if (!in_heap(p->comp, sizeof(hal_obj_t)) ||
-            ((hal_obj_t *)SHMPTR(p->comp))->kind != K_COMP) {
+        if (!hal_obj_at(p->comp, K_COMP)) {
             note(rep, len, "pin '%s' has no owner", p->o.name);
             bad++;
         }
@@ -2042,7 +2212,7 @@ int hal_check_consistency(char *rep, int len)
         long guard = 0;
         for (hoff_t e = t->functs; e && guard++ <= n[K_FUNCT] * 64L + 64;
              e = ((hal_fentry_t *)SHMPTR(e))->next) {
-            if (!in_heap(e, sizeof(hal_fentry_t))) {
+            if (!hal_block_at(e, sizeof(hal_fentry_t))) {
                 note(rep, len, "thread '%s' function list is broken",
                          t->o.name);
                 bad++;
@@ -2070,6 +2240,10 @@ int hal_check_consistency(char *rep, int len)
             bad++;
         }
     }
+    if (hal_damage_seen()) {
+        snprintf(rep, len, "%s", hal_last_error());
+        bad++;
+    }
     hal_unlock();
     free(sigs);
     free(functs);
@@ -2086,12 +2260,21 @@ int hal_check_consistency(char *rep, int len)
 static void recover_after_dead_holder(void)
 {
     hal_header_t *h = hal_map.hdr;
-    memset(SHMPTR(h->buckets), 0, h->nbuckets * sizeof(hoff_t));
+    memset(SHMPTR(hal_map.buckets), 0, hal_map.nbuckets * sizeof(hoff_t));
     for (int k = 1; k < K_NKINDS; k++) {
         hoff_t prev = 0;
         int n = 0;
         for (hoff_t o = h->list_head[k]; o;) {
-            hal_obj_t *obj = SHMPTR(o);
+            hal_obj_t *obj = hal_obj_get(o, k, "the list of",
+                                         kind_word(k));
+            if (!obj || n >= (long)HAL_WALK_MAX) {
+                /* cut the list where it is damaged */
+                if (prev)
+                    ((hal_obj_t *)SHMPTR(prev))->next = 0;
+                else
+                    h->list_head[k] = 0;
+                break;
+            }
             obj->prev = prev;
             index_insert(obj);
             prev = o;
@@ -2111,8 +2294,8 @@ static void recover_after_dead_holder(void)
     FOR_EACH(K_PIN, hal_pin_t, p) {
         if (!p->signal)
             continue;
-        hal_sig_t *s = SHMPTR(p->signal);
-        if (s->o.kind != K_SIG) {
+        hal_sig_t *s = hal_obj_at(p->signal, K_SIG);
+        if (!s) {
             p->signal = 0;
             write_cell(p, &p->dummy);
             continue;
@@ -2295,20 +2478,14 @@ int hal_instance_create(const char *shm_name, const char *instance,
     h->host_base = (uint64_t)(uintptr_t)base;
     h->next_id = 1;
     h->msg_level = 1;
-    /* name index: about one bucket per 1 KiB of segment */
-    uint32_t nb = 1024;
-    while (nb < (uint64_t)size / 1024 && nb < (1u << 20))
-        nb <<= 1;
-    h->buckets = (hoff_t)((sizeof(*h) + 63) & ~63UL);
-    h->nbuckets = nb;
-    h->heap_start = (hoff_t)((h->buckets + nb * sizeof(hoff_t) + 63)
-                             & ~63UL);
+    hal_layout((uint64_t)size, &h->buckets, &h->nbuckets, &h->heap_start);
     h->heap_top = h->heap_start;
     h->heap_end = (hoff_t)size;
     hal_map.base = base;
     hal_map.hdr = h;
     hal_map.size = size;
     hal_map.is_host = 1;
+    hal_map_checked();
     __atomic_store_n(&h->magic, HAL_MAGIC, __ATOMIC_RELEASE);
     return 0;
 }
@@ -2396,7 +2573,11 @@ int hal_instance_attach(const char *shm_name)
     hal_map.hdr = h;
     hal_map.size = st.st_size;
     hal_map.is_host = 0;
-    return 0;
+    if ((r = hal_map_checked())) {
+        munmap(base, st.st_size);
+        memset(&hal_map, 0, sizeof(hal_map));
+    }
+    return r;
 }
 
 void hal_instance_detach(int unlink_shm, const char *shm_name)

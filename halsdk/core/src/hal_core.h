@@ -232,18 +232,106 @@ typedef struct {
     int32_t lock_holder;        /* pid holding the mutex, 0: none (ABI 4) */
 } hal_header_t;
 
-/* a mapping of an instance in this process */
+/* a mapping of an instance in this process; heap_start, heap_end and
+   name are copies of header fields checked when the segment was mapped
+   (hal_check.c), so that no later stray write to the header moves the
+   bounds the checks below use */
 typedef struct {
     char *base;
     hal_header_t *hdr;
     long size;
     int is_host;
+    hoff_t heap_start, heap_end;
+    hoff_t buckets;
+    uint32_t nbuckets;
+    char name[64];
 } hal_map_t;
 
 extern hal_map_t hal_map;       /* the instance this process uses */
 
 #define SHMPTR(off) ((void *)(hal_map.base + (off)))
 #define SHMOFF(ptr) ((hoff_t)((char *)(ptr) - hal_map.base))
+
+/*
+ * The trust boundary (hal_check.c).  Every process attached to an
+ * instance can write anywhere in its segment, so a buggy component can
+ * leave any offset or count there.  Every offset read from the segment
+ * is checked with these before it is followed: inside the heap, aligned,
+ * in a used block and, for an object, of the kind expected.  A failed
+ * check reports "instance NAME is damaged: what, where" (hal_damaged,
+ * -EUCLEAN) instead of following the offset.  Walks of lists are bounded
+ * by HAL_WALK_MAX steps, so that a cycle ends as damage too.  The
+ * realtime paths (a thread's cycle, pins read through their pointers,
+ * stream records) use only what was checked when they were configured.
+ */
+#define HAL_ALIGN 16            /* blocks and the records in them */
+
+/* [off, off + size) lies inside the heap and off is a multiple of align
+   (a power of two) */
+static inline int hal_off_ok(uint64_t off, uint64_t size, uint32_t align)
+{
+    return off >= hal_map.heap_start && size <= hal_map.heap_end &&
+           off <= hal_map.heap_end - size && (off & (align - 1)) == 0;
+}
+
+/* the used block whose data starts at off and holds at least size
+   bytes, or NULL */
+static inline void *hal_block_at(uint64_t off, uint64_t size)
+{
+    if (off < (uint64_t)hal_map.heap_start + 16 ||
+        !hal_off_ok(off, size, HAL_ALIGN))
+        return NULL;
+    const hal_block_t *b = (const hal_block_t *)SHMPTR(off) - 1;
+    if (b->magic != HAL_BLOCK_USED || b->size < size ||
+        b->size > hal_map.heap_end - off)
+        return NULL;
+    return SHMPTR(off);
+}
+
+/* smallest record of each kind (hal_check.c) */
+uint32_t hal_kind_size(int kind);
+
+/* the record of that kind (K_NONE: of any kind) at off, its block used
+   and its name terminated, or NULL */
+static inline void *hal_obj_at(uint64_t off, int kind)
+{
+    if (kind < 0 || kind >= K_NKINDS)
+        return NULL;
+    const hal_obj_t *o = hal_block_at(off, hal_kind_size(kind));
+    if (!o || o->name[HAL_NAME_SIZE - 1] != 0)
+        return NULL;
+    if (kind ? o->kind != kind : o->kind == 0 || o->kind >= K_NKINDS)
+        return NULL;
+    return (void *)o;
+}
+
+/* a walk of a list of the segment takes at most this many steps */
+#define HAL_WALK_MAX ((hal_map.heap_end - hal_map.heap_start) / 32 + 1)
+
+/* report damage: returns -EUCLEAN, the message "instance NAME is damaged:
+   " and what fmt says.  Until the next hal_lock() (or hal_damage_take),
+   failures keep this message: an operation that stops at damage reports
+   the damage, not "not found". */
+int hal_damaged(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+int hal_damage_seen(void);      /* damage reported since the last lock */
+int hal_damage_take(void);      /* the same, and forget it */
+/* the record of that kind at off, or NULL with the damage reported:
+   "what" (e.g. "pin 'x' signal") "offset N is not a kind" */
+void *hal_obj_get(hoff_t off, int kind, const char *what, const char *name);
+/* the header checks (each listing, lock held): 0 or hal_damaged's */
+int hal_check_header(void);
+/* a segment just mapped (hal_map.base, .hdr, .size set): check its
+   header (without the lock) and set the bounds above; 0 or damage */
+int hal_map_checked(void);
+/* where a segment of size bytes has its name index and heap */
+void hal_layout(uint64_t size, hoff_t *buckets, uint32_t *nbuckets,
+                hoff_t *heap_start);
+const char *hal_kind_word(int kind);
+/* list walks: the first record of a kind's list, and the one after o,
+   or NULL at the end or with the damage reported; steps counts the
+   walk's steps against HAL_WALK_MAX */
+void *hal_walk_first(int kind);
+void *hal_walk_next(int kind, const hal_obj_t *o, long *steps);
 
 /*
  * The rules of HAL.  A failing operation reports -errno, a message naming

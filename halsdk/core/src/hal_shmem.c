@@ -19,7 +19,15 @@
 
 static hal_shmem_t *block_of(long long handle)
 {
-    return hal_handle_get(handle, K_SHMEM, sizeof(hal_shmem_t));
+    hal_shmem_t *b = hal_handle_get(handle, K_SHMEM, sizeof(hal_shmem_t));
+    if (b && (b->data < SHMOFF(b) + sizeof(hal_shmem_t) ||
+              !hal_off_ok(b->data, b->size, ALIGN))) {
+        hal_damaged("shared block '%.40s': %llu bytes at offset %u are "
+                    "outside the heap", b->o.name,
+                    (unsigned long long)b->size, b->data);
+        return NULL;
+    }
+    return b;
 }
 
 long long hal_shmem_new(const char *name, int owner_id, long size)
@@ -32,7 +40,7 @@ long long hal_shmem_new(const char *name, int owner_id, long size)
     if (!hal_map.hdr)
         return hal_fail(ENODEV, "no HAL instance is attached");
     if (size < 1 || (uint64_t)size + sizeof(hal_shmem_t) + ALIGN >
-        (uint64_t)(hal_map.hdr->heap_end - hal_map.hdr->heap_start))
+        (uint64_t)(hal_map.heap_end - hal_map.heap_start))
         return hal_fail(size < 1 ? EINVAL : ENOMEM, "%s: size %ld does "
                         "not fit in the HAL instance", what, size);
     if ((r = hal_lock()))

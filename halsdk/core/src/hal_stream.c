@@ -59,9 +59,22 @@ int hal_stream_parse_types(const char *typestring, uint8_t *types,
     return n;
 }
 
+/* the stream of a handle, its geometry checked (a few compares: this is
+   on the realtime path of every write and read), or NULL */
 hal_stream_t *hal_stream_get(long long handle)
 {
-    return hal_handle_get(handle, K_STREAM, sizeof(hal_stream_t));
+    hal_stream_t *s = hal_handle_get(handle, K_STREAM,
+                                     sizeof(hal_stream_t));
+    if (s && (s->nelem < 1 || s->nelem > HAL_STREAM_MAX_ELEMS ||
+              s->depth < 1 || s->stride != 8 * (uint32_t)(s->nelem + 1) ||
+              !hal_off_ok(SHMOFF(s), sizeof(hal_stream_t) +
+                          (uint64_t)s->depth * s->stride, HAL_ALIGN))) {
+        hal_damaged("stream '%.40s' at offset %u: %d values, depth %d and "
+                    "stride %u do not fit", s->o.name, SHMOFF(s), s->nelem,
+                    s->depth, s->stride);
+        return NULL;
+    }
+    return s;
 }
 
 /* records a stream holds at most: the one place of that rule */
@@ -95,7 +108,7 @@ long long hal_stream_create(const char *name, int owner_id, int depth,
     uint64_t size = sizeof(hal_stream_t) + (uint64_t)depth * stride;
     if (!hal_map.hdr)
         return hal_fail(ENODEV, "no HAL instance is attached");
-    if (size > (uint64_t)(hal_map.hdr->heap_end - hal_map.hdr->heap_start))
+    if (size > (uint64_t)(hal_map.heap_end - hal_map.heap_start))
         return hal_fail(ENOMEM, "%s: %d records of %d values do not fit in "
                         "the HAL instance", what, depth, n);
     if ((r = hal_lock()))

@@ -148,6 +148,34 @@ static xlist_t *empty_list(void)
     return calloc(1, sizeof(xlist_t));
 }
 
+/* the cells a cycle writes its timing to, checked once here so that the
+   cycle itself checks nothing: 0, or -EUCLEAN with the damage reported */
+static int timing_cells(const char *name, hoff_t time_pin, hoff_t tmax,
+                        hoff_t tmax_inc, volatile int32_t ***time_cell,
+                        volatile int32_t **tmax_out,
+                        volatile uint8_t **tmax_inc_out)
+{
+    hal_pin_t *tp = hal_obj_get(time_pin, K_PIN, "the .time pin of", name);
+    hal_param_t *tm = tp ? hal_obj_get(tmax, K_PARAM, "the .tmax param of",
+                                       name) : NULL;
+    hal_param_t *ti = tm && tmax_inc_out
+                      ? hal_obj_get(tmax_inc, K_PARAM, "the "
+                                    ".tmax-increased param of", name)
+                      : NULL;
+    if (!tm || (tmax_inc_out && !ti))
+        return -EUCLEAN;
+    if (!hal_off_ok(tp->ptr_cell, sizeof(void *), 1) ||
+        !hal_off_ok(tm->data, sizeof(int32_t), 1) ||
+        (ti && !hal_off_ok(ti->data, 1, 1)))
+        return hal_damaged("the timing pins of '%s' point outside the "
+                           "heap", name);
+    *time_cell = (volatile int32_t **)SHMPTR(tp->ptr_cell);
+    *tmax_out = SHMPTR(tm->data);
+    if (tmax_inc_out)
+        *tmax_inc_out = SHMPTR(ti->data);
+    return 0;
+}
+
 int exec_create(hal_thread_t *t)
 {
     for (int s = 0; s < HAL_MAX_THREADS; s++) {
@@ -165,10 +193,12 @@ int exec_create(hal_thread_t *t)
         x->period = t->period;
         x->every = t->timing_every;
         x->countdown = 1;
-        hal_pin_t *tp = SHMPTR(t->time_pin);
-        hal_param_t *tm = SHMPTR(t->tmax_param);
-        x->time_cell = (volatile int32_t **)SHMPTR(tp->ptr_cell);
-        x->tmax = SHMPTR(tm->data);
+        if (timing_cells(t->o.name, t->time_pin, t->tmax_param, 0,
+                         &x->time_cell, &x->tmax, NULL)) {
+            free(atomic_exchange(&x->list, NULL));
+            x->used = 0;
+            return -EUCLEAN;
+        }
         x->sim_next = -1;
         /* threads made while HAL runs start at once */
         if (hal_map.hdr->threads_running) {
@@ -199,10 +229,17 @@ static int wait_grace(executor_t *x)
     return -1;
 }
 
+/* a thread record's executor slot is read from the segment: the
+   executor, or NULL for a slot out of range (damage) */
+static executor_t *exec_at(int slot)
+{
+    return slot >= 0 && slot < HAL_MAX_THREADS ? &execs[slot] : NULL;
+}
+
 void exec_stop(int slot)
 {
-    executor_t *x = &execs[slot];
-    if (!x->used || !x->started)
+    executor_t *x = exec_at(slot);
+    if (!x || !x->used || !x->started)
         return;
     atomic_store(&x->stop, 1);
     pthread_join(x->tid, NULL);
@@ -212,7 +249,11 @@ void exec_stop(int slot)
 
 void exec_destroy(int slot)
 {
-    executor_t *x = &execs[slot];
+    executor_t *x = exec_at(slot);
+    if (!x) {
+        hal_damaged("a thread has executor slot %d", slot);
+        return;
+    }
     if (!x->used)
         return;
     exec_stop(slot);
@@ -233,23 +274,41 @@ int exec_publish(hal_thread_t *t)
 {
     if (!hal_map.is_host)
         return 0;
-    executor_t *x = &execs[t->slot];
+    executor_t *x = exec_at(t->slot);
+    if (!x)
+        return hal_damaged("thread '%s' has executor slot %d", t->o.name,
+                           t->slot);
     if (!x->used || x->t != t)
         return hal_fail(EINVAL, "thread '%s' has no executor", t->o.name);
+    if (t->nfuncts < 0 || t->nfuncts > (long)HAL_WALK_MAX)
+        return hal_damaged("thread '%s' has %d functions", t->o.name,
+                           t->nfuncts);
     xlist_t *l = malloc(sizeof(xlist_t) + t->nfuncts * sizeof(xentry_t));
     if (!l)
         return hal_fail(ENOMEM, "thread '%s': out of memory", t->o.name);
     int n = 0;
-    for (hoff_t eo = t->functs; eo; eo = ((hal_fentry_t *)SHMPTR(eo))->next) {
-        hal_funct_t *f = SHMPTR(((hal_fentry_t *)SHMPTR(eo))->funct);
-        xentry_t *e = &l->e[n++];
+    for (hoff_t eo = t->functs; eo;) {
+        /* checked here, once, so that the cycle checks nothing */
+        hal_fentry_t *fe = hal_block_at(eo, sizeof(hal_fentry_t));
+        hal_funct_t *f = NULL;
+        if (!fe || n >= t->nfuncts)
+            hal_damaged("thread '%s': function list entry %d at offset %u "
+                        "is not an entry (or the list is longer than its "
+                        "count %d)", t->o.name, n, eo, t->nfuncts);
+        else
+            f = hal_obj_get(fe->funct, K_FUNCT, "a function of thread",
+                            t->o.name);
+        xentry_t *e = f ? &l->e[n] : NULL;
+        if (!e || timing_cells(f->o.name, f->time_pin, f->tmax_param,
+                               f->tmax_inc_param, &e->time_cell, &e->tmax,
+                               &e->tmax_inc)) {
+            free(l);
+            return -EUCLEAN;
+        }
         e->fn = (halsdk_funct_t)(uintptr_t)f->fn;
         e->arg = (void *)(uintptr_t)f->arg;
-        hal_pin_t *tp = SHMPTR(f->time_pin);
-        e->time_cell = (volatile int32_t **)SHMPTR(tp->ptr_cell);
-        e->tmax = SHMPTR(((hal_param_t *)SHMPTR(f->tmax_param))->data);
-        e->tmax_inc = SHMPTR(((hal_param_t *)SHMPTR(f->tmax_inc_param))
-                             ->data);
+        n++;
+        eo = fe->next;
     }
     l->n = n;
     xlist_t *old = atomic_exchange(&x->list, l);
@@ -313,8 +372,8 @@ static void *thread_main(void *arg)
 
 int exec_start(int slot, int want_rt, char *note, int notelen)
 {
-    executor_t *x = &execs[slot];
-    if (!x->used || x->started)
+    executor_t *x = exec_at(slot);
+    if (!x || !x->used || x->started)
         return 0;
     calibrate_ticks();
     atomic_store(&x->stop, 0);
@@ -447,7 +506,9 @@ int exec_stepping(void)
 /* run one thread n cycles; the simulated clock follows it */
 int exec_run_cycles(int slot, long n)
 {
-    executor_t *x = &execs[slot];
+    executor_t *x = exec_at(slot);
+    if (!x)
+        return hal_damaged("a thread has executor slot %d", slot);
     if (!x->used)
         return hal_fail(EINVAL, "no such thread executor");
     int r = begin_stepping();
