@@ -539,7 +539,9 @@ def test_sigkill_while_holding_instance_mutex(hal, spawn):
     mutex = MutexOwner(segment_file())
     try:
         if mutex.available:
-            assert mutex.owner() == 0
+            # the host's watch of userspace components locks now and
+            # then (halsdk.core.instance.Reaper)
+            wait_for(lambda: mutex.owner() == 0, "the mutex to be free")
         recovered = hal.info()["recovered"]
         child, _ = start_driver(spawn)
         child.send({"hold_lock": 30})
@@ -563,7 +565,10 @@ def test_sigkill_while_holding_instance_mutex(hal, spawn):
     # The host locks again.  The core waits for the mutex holding the GIL,
     # so a join timeout alone could not end a hang: faulthandler ends the
     # whole run instead of letting it hang forever.
-    assert hal.info()["recovered"] == recovered     # nobody locked yet
+    # the host's component watch may be the first to lock and recover
+    # the mutex (the child's death wakes it); there is one recovery either
+    # way
+    assert hal.info()["recovered"] in (recovered, recovered + 1)
     result: dict[str, Any] = {}
 
     def relock() -> None:

@@ -27,15 +27,6 @@
 
 hal_map_t hal_map;
 
-/* each record of a kind's list, checked (hal_walk_first/next); the body
-   may delete var */
-#define FOR_EACH(kind, type, var)                                         \
-    for (long var##_n = 0; var##_n == 0; var##_n = -1)                    \
-        for (type *var = hal_walk_first(kind), *var##_nx = NULL;          \
-             var && ((var##_nx = hal_walk_next(kind, &var->o,             \
-                                               &var##_n)), 1);            \
-             var = var##_nx)
-
 static const char *kind_word(int kind)
 {
     return hal_kind_word(kind);
@@ -529,9 +520,7 @@ static void *find_in_space(int space, const char *name)
     return NULL;
 }
 
-/* the original name of an aliased item, or NULL with the damage
-   reported */
-static char *oldname_of(hal_item_t *it)
+char *hal_oldname_of(hal_item_t *it)
 {
     char *n = hal_block_at(it->oldname, HAL_NAME_SIZE);
     if (!n || n[HAL_NAME_SIZE - 1] != 0) {
@@ -555,7 +544,7 @@ void *hal_find(int kind, const char *name)
     /* an aliased pin or param still answers to its original name */
     if ((kind == K_PIN || kind == K_PARAM) && hal_map.hdr->naliases > 0) {
         FOR_EACH(kind, hal_item_t, it) {
-            const char *old = it->oldname ? oldname_of(it) : NULL;
+            const char *old = it->oldname ? hal_oldname_of(it) : NULL;
             if (old && strcmp(old, name) == 0)
                 return it;
         }
@@ -1088,7 +1077,7 @@ int hal_unalias(int kind, const char *alias)
         r = fail_not_found(kind, alias);
         goto out;
     }
-    char *orig = oldname_of((hal_item_t *)o);
+    char *orig = hal_oldname_of((hal_item_t *)o);
     if (!orig) {
         r = -EUCLEAN;
         goto out;
@@ -1175,7 +1164,7 @@ static void item_delete(hal_item_t *it)
     if (it->o.kind == K_PIN && ((hal_pin_t *)it)->signal)
         unlink_locked((hal_pin_t *)it);
     if (it->oldname) {
-        char *old = oldname_of(it);
+        char *old = hal_oldname_of(it);
         if (old)
             hal_free(old);
         hal_map.hdr->naliases--;
@@ -1684,7 +1673,7 @@ out:
 
 /* the entry at off of thread t's function list, or NULL with the damage
    reported; steps counts the walk */
-static hal_fentry_t *fentry_at(hal_thread_t *t, hoff_t off, long *steps)
+hal_fentry_t *hal_fentry_at(hal_thread_t *t, hoff_t off, long *steps)
 {
     if (!hal_block_at(off, sizeof(hal_fentry_t)) ||
         ++*steps > (long)t->nfuncts + 1 || *steps > (long)HAL_WALK_MAX) {
@@ -1704,7 +1693,7 @@ static int drop_entries(hal_thread_t *t, hoff_t fo)
     hoff_t *link = &t->functs;
     long steps = 0;
     while (*link) {
-        hal_fentry_t *e = fentry_at(t, *link, &steps);
+        hal_fentry_t *e = hal_fentry_at(t, *link, &steps);
         if (!e) {
             *link = 0;          /* drop (leak) the rest of the list */
             break;
@@ -1806,7 +1795,7 @@ int hal_addf(const char *funct, const char *thread, int position)
     hoff_t *link = &t->functs;
     long steps = 0;
     for (int k = 0; k < index; k++) {
-        hal_fentry_t *x = fentry_at(t, *link, &steps);
+        hal_fentry_t *x = hal_fentry_at(t, *link, &steps);
         if (!x) {
             hal_free(e);
             r = -EUCLEAN;
@@ -1859,7 +1848,7 @@ int hal_delf(const char *funct, const char *thread)
     hoff_t *link = &t->functs, fo = SHMOFF(f);
     long steps = 0;
     while (*link) {
-        hal_fentry_t *x = fentry_at(t, *link, &steps);
+        hal_fentry_t *x = hal_fentry_at(t, *link, &steps);
         if (!x) {
             r = -EUCLEAN;
             goto out;

@@ -333,6 +333,15 @@ const char *hal_kind_word(int kind);
 void *hal_walk_first(int kind);
 void *hal_walk_next(int kind, const hal_obj_t *o, long *steps);
 
+/* each record of a kind's list, checked (hal_walk_first/next); the body
+   may delete var */
+#define FOR_EACH(kind, type, var)                                         \
+    for (long var##_n = 0; var##_n == 0; var##_n = -1)                    \
+        for (type *var = hal_walk_first(kind), *var##_nx = NULL;          \
+             var && ((var##_nx = hal_walk_next(kind, &var->o,             \
+                                               &var##_n)), 1);            \
+             var = var##_nx)
+
 /*
  * The rules of HAL.  A failing operation reports -errno, a message naming
  * the objects (hal_last_error) and the rule it enforces (hal_last_rule),
@@ -541,6 +550,12 @@ int hal_snapshot(int kind, hal_snapshot_t *snap);   /* takes the lock */
 void hal_snapshot_free(hal_snapshot_t *snap);
 
 /* values */
+/* the original name of an aliased pin or param, or NULL with the damage
+   reported */
+char *hal_oldname_of(hal_item_t *it);
+/* the entry at off of a thread's function list, or NULL with the damage
+   reported; steps counts the walk against the thread's nfuncts */
+hal_fentry_t *hal_fentry_at(hal_thread_t *t, hoff_t off, long *steps);
 hal_value_t *hal_pin_value(hal_pin_t *pin);
 void *hal_param_value(hal_param_t *param);
 

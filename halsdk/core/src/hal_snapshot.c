@@ -90,14 +90,38 @@ static uint64_t raw_value(int type, const volatile void *p)
     return v;
 }
 
-static const char *obj_name(hoff_t off)
+/* the name of the record of that kind at off ("" for none; "?" with the
+   damage reported when off is not such a record) */
+static const char *obj_name(hoff_t off, int kind)
 {
-    return off ? ((hal_obj_t *)SHMPTR(off))->name : "";
+    if (!off)
+        return "";
+    hal_obj_t *o = hal_obj_at(off, kind);
+    if (!o) {
+        hal_damaged("offset %u is not a %s record", off,
+                    hal_kind_word(kind));
+        return "?";
+    }
+    return o->name;
 }
 
 static int comp_id(hoff_t off)
 {
-    return off ? ((hal_comp_t *)SHMPTR(off))->id : 0;
+    hal_comp_t *c = off ? hal_obj_at(off, K_COMP) : NULL;
+    return c ? c->id : 0;
+}
+
+/* the s32 value of a function's or thread's time pin / tmax param */
+static int32_t time_pin(hoff_t off)
+{
+    hal_pin_t *p = off ? hal_obj_at(off, K_PIN) : NULL;
+    return p ? hal_pin_value(p)->s : 0;
+}
+
+static int32_t tmax_param(hoff_t off)
+{
+    hal_param_t *p = off ? hal_obj_at(off, K_PARAM) : NULL;
+    return p ? *(int32_t *)hal_param_value(p) : 0;
 }
 
 /* signal offset -> record index, sorted by offset */
@@ -131,7 +155,6 @@ static long find_sig(const sig_index_t *v, long n, hoff_t off)
 /* the pins of every signal (lock held): O(pins log signals) */
 static int signal_pins(hal_snapshot_t *s)
 {
-    hal_header_t *h = hal_map.hdr;
     long ns = s->nrecs;
     sig_index_t *ix = malloc((ns ? ns : 1) * sizeof(*ix));
     if (!ix)
@@ -142,14 +165,12 @@ static int signal_pins(hal_snapshot_t *s)
     }
     qsort(ix, ns, sizeof(*ix), cmp_sig_index);
     long total = 0;
-    for (hoff_t o = h->list_head[K_PIN]; o;) {
-        hal_pin_t *p = SHMPTR(o);
+    FOR_EACH(K_PIN, hal_pin_t, p) {
         long i = p->signal ? find_sig(ix, ns, p->signal) : -1;
         if (i >= 0) {
             s->recs[i].nsub++;
             total++;
         }
-        o = p->o.next;
     }
     if (subs_reserve(s, total) < 0) {
         free(ix);
@@ -161,10 +182,10 @@ static int signal_pins(hal_snapshot_t *s)
         at += s->recs[k].nsub;
         s->recs[k].nsub = 0;
     }
-    for (hoff_t o = h->list_head[K_PIN]; o;) {
-        hal_pin_t *p = SHMPTR(o);
+    FOR_EACH(K_PIN, hal_pin_t, p) {
         long i = p->signal ? find_sig(ix, ns, p->signal) : -1;
-        if (i >= 0) {
+        /* the list may have changed only by damage since the count */
+        if (i >= 0 && s->recs[i].sub + s->recs[i].nsub < total) {
             hal_snap_t *r = &s->recs[i];
             hal_snap_sub_t *sub = &s->subs[r->sub + r->nsub++];
             sub->dir = p->dir;
@@ -173,7 +194,6 @@ static int signal_pins(hal_snapshot_t *s)
                 return -1;
             }
         }
-        o = p->o.next;
     }
     s->nsubs = total;
     free(ix);
@@ -204,7 +224,7 @@ static int snap_one(hal_snapshot_t *s, int kind, hal_obj_t *o)
     case K_INST: {
         hal_inst_t *i = (hal_inst_t *)o;
         r->id = i->id;
-        return pool_add(s, obj_name(i->comp), &r->owner);
+        return pool_add(s, obj_name(i->comp, K_COMP), &r->owner);
     }
     case K_PIN:
     case K_PARAM: {
@@ -215,16 +235,18 @@ static int snap_one(hal_snapshot_t *s, int kind, hal_obj_t *o)
         if (kind == K_PIN) {
             hal_pin_t *p = (hal_pin_t *)o;
             r->value = raw_value(p->type, hal_pin_value(p));
-            if (pool_add(s, obj_name(p->signal), &r->link) < 0)
+            if (pool_add(s, obj_name(p->signal, K_SIG), &r->link) < 0)
                 return -1;
         } else {
             r->value = raw_value(it->type,
                                  hal_param_value((hal_param_t *)o));
         }
-        if (it->oldname && pool_add(s, (char *)SHMPTR(it->oldname),
-                                    &r->alias) < 0)
-            return -1;
-        return pool_add(s, obj_name(it->comp), &r->owner);
+        if (it->oldname) {
+            const char *old = hal_oldname_of(it);
+            if (pool_add(s, old ? old : "?", &r->alias) < 0)
+                return -1;
+        }
+        return pool_add(s, obj_name(it->comp, K_COMP), &r->owner);
     }
     case K_SIG: {
         hal_sig_t *g = (hal_sig_t *)o;
@@ -241,11 +263,9 @@ static int snap_one(hal_snapshot_t *s, int kind, hal_obj_t *o)
         r->flags = (f->uses_fp ? 1 : 0) | (f->reentrant ? 2 : 0)
                    | (f->python ? 4 : 0);
         r->users = f->users;
-        if (f->time_pin)
-            r->time = hal_pin_value(SHMPTR(f->time_pin))->s;
-        if (f->tmax_param)
-            r->tmax = *(int32_t *)hal_param_value(SHMPTR(f->tmax_param));
-        return pool_add(s, obj_name(f->comp), &r->owner);
+        r->time = time_pin(f->time_pin);
+        r->tmax = tmax_param(f->tmax_param);
+        return pool_add(s, obj_name(f->comp, K_COMP), &r->owner);
     }
     case K_THREAD: {
         hal_thread_t *t = (hal_thread_t *)o;
@@ -253,27 +273,34 @@ static int snap_one(hal_snapshot_t *s, int kind, hal_obj_t *o)
         r->flags = (t->uses_fp ? 1 : 0) | (t->running ? 2 : 0);
         r->cycles = t->cycles;
         r->overruns = t->overruns;
-        if (t->time_pin)
-            r->time = hal_pin_value(SHMPTR(t->time_pin))->s;
-        if (t->tmax_param)
-            r->tmax = *(int32_t *)hal_param_value(SHMPTR(t->tmax_param));
+        r->time = time_pin(t->time_pin);
+        r->tmax = tmax_param(t->tmax_param);
+        if (t->nfuncts < 0 || t->nfuncts > (long)HAL_WALK_MAX) {
+            hal_damaged("thread '%s': %d functions", t->o.name,
+                        t->nfuncts);
+            break;
+        }
         if (subs_reserve(s, s->nsubs + t->nfuncts) < 0)
             return -1;
         r->sub = (uint32_t)s->nsubs;
-        for (hoff_t e = t->functs; e && r->nsub < (uint32_t)t->nfuncts;
-             e = ((hal_fentry_t *)SHMPTR(e))->next) {
+        long steps = 0;
+        for (hoff_t e = t->functs; e && r->nsub < (uint32_t)t->nfuncts;) {
+            hal_fentry_t *x = hal_fentry_at(t, e, &steps);
+            if (!x)
+                break;
             hal_snap_sub_t *sub = &s->subs[s->nsubs++];
             sub->dir = 0;
             r->nsub++;
-            if (pool_add(s, obj_name(((hal_fentry_t *)SHMPTR(e))->funct),
-                         &sub->name) < 0)
+            if (pool_add(s, obj_name(x->funct, K_FUNCT), &sub->name) < 0)
                 return -1;
+            e = x->next;
         }
         break;
     }
     case K_STREAM:
     case K_SHMEM:
-        return pool_add(s, obj_name(((hal_owned_t *)o)->comp), &r->owner);
+        return pool_add(s, obj_name(((hal_owned_t *)o)->comp, K_COMP),
+                        &r->owner);
     }
     return 0;
 }
@@ -294,7 +321,6 @@ int hal_snapshot(int kind, hal_snapshot_t *s)
     int r = hal_lock();
     if (r)
         return r;
-    hal_header_t *h = hal_map.hdr;
     /* pool offset 0 is the empty string */
     s->pool = malloc(4096);
     int bad = s->pool == NULL;
@@ -303,18 +329,22 @@ int hal_snapshot(int kind, hal_snapshot_t *s)
         s->npool = 1;
         s->cappool = 4096;
     }
-    for (hoff_t o = h->list_head[kind]; o && !bad;) {
-        hal_obj_t *obj = SHMPTR(o);
+    if (!bad && hal_check_header() < 0)
+        bad = 1;
+    long steps = 0;
+    for (hal_obj_t *obj = hal_walk_first(kind); obj && !bad &&
+         !hal_damage_seen(); obj = hal_walk_next(kind, obj, &steps))
         bad = snap_one(s, kind, obj) < 0;
-        o = obj->next;
-    }
-    if (!bad && kind == K_SIG)
+    if (!bad && !hal_damage_seen() && kind == K_SIG)
         bad = signal_pins(s) < 0;
+    int damaged = hal_damage_seen();
     hal_unlock();
-    if (bad) {
+    if (bad || damaged) {
         hal_snapshot_free(s);
+        if (damaged)
+            return -EUCLEAN;
         return hal_fail(ENOMEM, "out of memory while listing HAL "
-                        "instance '%s'", h->instance);
+                        "instance '%s'", hal_map.name);
     }
     return 0;
 }
