@@ -386,6 +386,8 @@ def run_forked(host: Host, inp: Input, cmd_file: str, timeout: float,
             devnull = os.open(os.devnull, os.O_WRONLY)
             os.dup2(devnull, 1)
             os.dup2(w, 2)
+            import faulthandler
+            faulthandler.register(signal.SIGUSR1, all_threads=True)
             code = child_main(cmd_file, host.instance)
         except BaseException:
             os.write(w, traceback.format_exc().encode())
@@ -409,12 +411,18 @@ def run_forked(host: Host, inp: Input, cmd_file: str, timeout: float,
         if not chunk:
             break
         err += chunk
+    if hung:
+        # where it hangs: the Python stacks (faulthandler), then end it
+        os.kill(pid, signal.SIGUSR1)
+        if select.select([r], [], [], 2.0)[0]:
+            err += os.read(r, 65536)
     os.close(r)
     if hung:
         os.kill(pid, signal.SIGKILL)
         os.waitpid(pid, 0)
         counts.hangs += 1
-        counts.examples.append(f"hang: {inp}")
+        stacks = err.decode("utf-8", "replace")[-3000:]
+        counts.examples.append(f"hang: {inp}\n{stacks}")
     else:
         status = os.waitpid(pid, 0)[1]
     counts.inputs += 1
@@ -476,26 +484,12 @@ def leftovers(instance_prefix: str) -> int:
                if n.startswith(f"halsdk-{uid}-{instance_prefix}"))
 
 
-def main(argv: Optional[list[str]] = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--count", type=int, default=1000,
-                    help="inputs in all (default 1000)")
-    ap.add_argument("--jobs", type=int, default=1,
-                    help="workers, each with its own host (default 1)")
-    ap.add_argument("--seed", type=int, default=1)
-    ap.add_argument("--timeout", type=float, default=20.0,
-                    help="seconds an attaching process may take")
-    ap.add_argument("--mutex", action="store_true",
-                    help="damage the instance mutex too")
-    ap.add_argument("--examples", type=int, default=5,
-                    help="failures to print in full")
-    ap.add_argument("--verbose", action="store_true",
-                    help="also print a few ordinary errors")
-    args = ap.parse_args(argv)
-    t0 = time.monotonic()
+def run_campaign(count: int, seed: int = 1, jobs: int = 1,
+                 timeout: float = 20.0, mutex: bool = False) -> Counts:
+    """``count`` inputs in ``jobs`` forked workers (each with its own
+    host); their counts added up."""
     total = Counts()
-    per = [args.count // args.jobs + (i < args.count % args.jobs)
-           for i in range(args.jobs)]
+    per = [count // jobs + (i < count % jobs) for i in range(jobs)]
     pids = []
     for i, n in enumerate(per):
         r, w = os.pipe()
@@ -504,8 +498,8 @@ def main(argv: Optional[list[str]] = None) -> int:
             os.close(r)
             c = Counts()
             try:
-                c = worker(n, args.seed * 1000 + i, args.timeout,
-                           args.mutex, f"{args.seed}-{i}")
+                c = worker(n, seed * 1000 + i, timeout, mutex,
+                           f"{seed}-{i}")
             except BaseException:
                 c.tracebacks += 1
                 c.examples.append("worker: " + traceback.format_exc())
@@ -525,6 +519,45 @@ def main(argv: Optional[list[str]] = None) -> int:
         import ast
         d = ast.literal_eval(data.decode()) if data else {}
         total.add(Counts(**d) if d else Counts(tracebacks=1))
+    return total
+
+
+def campaign(count: int, seed: int = 1, jobs: int = 1,
+             mutex: bool = True) -> dict[str, Any]:
+    """The shared-memory kind of bench/reliability.py: its counts.  The
+    mutex is damaged too, with a short lock timeout (a damaged mutex
+    looks held: waits for it time out)."""
+    if mutex:
+        os.environ.setdefault("HALSDK_LOCK_TIMEOUT", "1")
+    t0 = time.monotonic()
+    total = run_campaign(count, seed, jobs, mutex=mutex)
+    return {"inputs": total.inputs, "crashes": total.crashes,
+            "tracebacks": total.tracebacks, "hangs": total.hangs,
+            "leftovers": total.leftovers,
+            "seconds": time.monotonic() - t0,
+            "findings": [ex.splitlines()[0] for ex in total.examples],
+            "damaged": total.damaged}
+
+
+def main(argv: Optional[list[str]] = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--count", type=int, default=1000,
+                    help="inputs in all (default 1000)")
+    ap.add_argument("--jobs", type=int, default=1,
+                    help="workers, each with its own host (default 1)")
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--timeout", type=float, default=20.0,
+                    help="seconds an attaching process may take")
+    ap.add_argument("--mutex", action="store_true",
+                    help="damage the instance mutex too")
+    ap.add_argument("--examples", type=int, default=5,
+                    help="failures to print in full")
+    ap.add_argument("--verbose", action="store_true",
+                    help="also print a few ordinary errors")
+    args = ap.parse_args(argv)
+    t0 = time.monotonic()
+    total = run_campaign(args.count, args.seed, args.jobs, args.timeout,
+                         args.mutex)
     elapsed = time.monotonic() - t0
     print(f"shared-memory corruption: {total.inputs} inputs in "
           f"{elapsed:.0f} s ({args.jobs} jobs, seed {args.seed})")

@@ -100,7 +100,7 @@ void *hal_walk_next(int kind, const hal_obj_t *o, long *steps)
 {
     if (!o->next)
         return NULL;
-    if (++*steps > (long)HAL_WALK_MAX) {
+    if (hal_walk_step(steps, SHMOFF(o), o->next)) {
         hal_damaged("the %s list does not end (a cycle after '%.40s')",
                     hal_kind_word(kind), o->name);
         return NULL;

@@ -507,14 +507,19 @@ static void *find_in_space(int space, const char *name)
     long steps = 0;
     for (hoff_t o = *bucket(x); o;) {
         hal_obj_t *obj = hal_obj_at(o, K_NONE);
-        if (!obj || ++steps > (long)HAL_WALK_MAX) {
+        if (!obj) {
             hal_damaged("name index chain of '%.40s': offset %u is not a "
-                        "record%s", name, o, obj ? " (a cycle)" : "");
+                        "record", name, o);
             return NULL;
         }
         if (obj->hash == x && name_space(obj->kind) == space &&
             strcmp(obj->name, name) == 0)
             return obj;
+        if (obj->hnext && hal_walk_step(&steps, o, obj->hnext)) {
+            hal_damaged("name index chain of '%.40s': a cycle after '%.40s'",
+                        name, obj->name);
+            return NULL;
+        }
         o = obj->hnext;
     }
     return NULL;
@@ -570,9 +575,9 @@ static void index_remove(hal_obj_t *o)
             break;
         }
         hal_obj_t *x = hal_obj_at(*link, K_NONE);
-        if (!x || ++steps > (long)HAL_WALK_MAX) {
+        if (!x || (x->hnext && hal_walk_step(&steps, *link, x->hnext))) {
             hal_damaged("name index chain of '%.40s': offset %u is not a "
-                        "record", o->name, *link);
+                        "record%s", o->name, *link, x ? " (a cycle)" : "");
             break;
         }
         link = &x->hnext;
@@ -761,6 +766,17 @@ static long type_size(int type)
     case HALSDK_S64: case HALSDK_U64: return 8;
     }
     return 0;
+}
+
+int hal_shape_ok(int kind, int type, int dir)
+{
+    if (!type_size(type))
+        return 0;
+    if (kind == K_PIN)
+        return dir == HALSDK_IN || dir == HALSDK_OUT || dir == HALSDK_IO;
+    if (kind == K_PARAM)
+        return dir == HALSDK_RO || dir == HALSDK_RW;
+    return 1;
 }
 
 static const char *type_word(int type)
@@ -976,9 +992,7 @@ static int item_add(int kind, const char *name, int type, int dir,
         return hal_rule(hal_fail(EINVAL, "%s '%s': bad type %d", what,
                                  name, type),
                         HAL_RULE_BAD_ARG, kind, name, NULL, NULL);
-    if (kind == K_PIN ? dir != HALSDK_IN && dir != HALSDK_OUT &&
-                        dir != HALSDK_IO
-                      : dir != HALSDK_RO && dir != HALSDK_RW)
+    if (!hal_shape_ok(kind, type, dir))
         return hal_rule(hal_fail(EINVAL, "%s '%s': bad direction %d", what,
                                  name, dir),
                         HAL_RULE_BAD_ARG, kind, name, NULL, NULL);

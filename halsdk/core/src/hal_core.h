@@ -308,6 +308,28 @@ static inline void *hal_obj_at(uint64_t off, int kind)
 /* a walk of a list of the segment takes at most this many steps */
 #define HAL_WALK_MAX ((hal_map.heap_end - hal_map.heap_start) / 32 + 1)
 
+/*
+ * One step of a walk along links in the segment, from the record at
+ * offset at to the one at next: 1 when next closes a cycle or the walk
+ * grew longer than HAL_WALK_MAX.  Cycles are found as Brent's algorithm
+ * finds them: the walk keeps the record it was at after 1, 2, 4, 8 ...
+ * steps, and a link back to it is a cycle, so a cycle ends the walk
+ * after about twice the list's length.  *state starts at 0; it packs the
+ * kept offset (high 32 bits) and the step count (low 32 bits).
+ */
+static inline int hal_walk_step(long *state, uint32_t at, uint32_t next)
+{
+    unsigned long st = (unsigned long)*state;
+    unsigned long n = (st & 0xffffffffUL) + 1;
+    uint32_t kept = (uint32_t)(st >> 32);
+    if (next == kept || n > (unsigned long)HAL_WALK_MAX)
+        return 1;
+    if ((n & (n - 1)) == 0)
+        kept = at;
+    *state = (long)(((unsigned long)kept << 32) | n);
+    return 0;
+}
+
 /* report damage: returns -EUCLEAN, the message "instance NAME is damaged:
    " and what fmt says.  Until the next hal_lock() (or hal_damage_take),
    failures keep this message: an operation that stops at damage reports
@@ -550,6 +572,9 @@ int hal_snapshot(int kind, hal_snapshot_t *snap);   /* takes the lock */
 void hal_snapshot_free(hal_snapshot_t *snap);
 
 /* values */
+/* a type (and, for a pin or param, a direction) that a record of that
+   kind may have */
+int hal_shape_ok(int kind, int type, int dir);
 /* the original name of an aliased pin or param, or NULL with the damage
    reported */
 char *hal_oldname_of(hal_item_t *it);

@@ -167,6 +167,11 @@ static int signal_pins(hal_snapshot_t *s)
     long total = 0;
     FOR_EACH(K_PIN, hal_pin_t, p) {
         long i = p->signal ? find_sig(ix, ns, p->signal) : -1;
+        if (i >= 0 && !hal_shape_ok(K_PIN, p->type, p->dir)) {
+            hal_damaged("pin '%s': type %d, direction %d", p->o.name,
+                        p->type, p->dir);
+            break;
+        }
         if (i >= 0) {
             s->recs[i].nsub++;
             total++;
@@ -229,6 +234,11 @@ static int snap_one(hal_snapshot_t *s, int kind, hal_obj_t *o)
     case K_PIN:
     case K_PARAM: {
         hal_item_t *it = (hal_item_t *)o;
+        if (!hal_shape_ok(kind, it->type, it->dir)) {
+            hal_damaged("%s '%s': type %d, direction %d",
+                        hal_kind_word(kind), o->name, it->type, it->dir);
+            return 0;
+        }
         r->id = comp_id(it->comp);
         r->type = it->type;
         r->dir = it->dir;
@@ -250,6 +260,10 @@ static int snap_one(hal_snapshot_t *s, int kind, hal_obj_t *o)
     }
     case K_SIG: {
         hal_sig_t *g = (hal_sig_t *)o;
+        if (!hal_shape_ok(K_SIG, g->type, 0)) {
+            hal_damaged("signal '%s': type %d", o->name, g->type);
+            return 0;
+        }
         r->type = g->type;
         r->value = raw_value(g->type, &g->value);
         r->readers = g->readers;
