@@ -4,13 +4,13 @@ per link that runs the link's transactions in turn."""
 from __future__ import annotations
 
 import logging
-import signal
 import threading
 import time
 from typing import Callable, Optional
 
 from halsdk.component import Component, component
 from halsdk.driverkit.backoff import Backoff
+from halsdk.driverkit.signals import StopSignals
 
 from .client import LinkDown, ModbusLink, Refused
 from .config import VERSION_1_1, Config, Link, Transaction
@@ -367,19 +367,14 @@ class Mb2hal:
     def run(self) -> None:
         """Start, then serve until SIGTERM/SIGINT, ``unloadusr`` or the
         end of the HAL host; coils go OFF then (:meth:`LinkWorker.go_safe`)."""
-        done = threading.Event()
-        old = {}
-        if threading.current_thread() is threading.main_thread():
-            for sig in (signal.SIGTERM, signal.SIGINT):
-                old[sig] = signal.signal(sig, lambda *_: done.set())
-        try:
-            self.start()
-            while not done.wait(0.1):
-                if self.comp is None or not self.comp.exists:
-                    break
-                if self.comp.host_gone:     # said on stderr by the core
-                    break
-        finally:
-            self.stop()
-            for sig, handler in old.items():
-                signal.signal(sig, handler)
+        with StopSignals() as signals:
+            try:
+                self.start()
+                while not signals.caught:
+                    if self.comp is None or not self.comp.exists:
+                        break
+                    if self.comp.host_gone:     # said on stderr by the core
+                        break
+                    time.sleep(0.02)
+            finally:
+                self.stop()

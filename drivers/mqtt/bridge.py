@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import logging
 import math
-import signal
 import threading
 import time
 from dataclasses import dataclass
@@ -13,6 +12,7 @@ from typing import Any, Callable, Optional
 
 from halsdk import Hal
 from halsdk.component import Component, component
+from halsdk.driverkit.signals import StopSignals
 from halsdk.errors import HalError
 from halsdk.types import type_word
 
@@ -302,15 +302,11 @@ class Bridge:
     # -- running -----------------------------------------------------------
     def run(self, handle_signals: bool = True) -> None:
         """Cycle until SIGTERM/SIGINT, :meth:`stop` or ``unloadusr``."""
-        old = {}
-        if handle_signals and threading.current_thread() is \
-                threading.main_thread():
-            for sig in (signal.SIGTERM, signal.SIGINT):
-                old[sig] = signal.signal(sig, lambda *_: self._stop.set())
+        signals = StopSignals(handle_signals).__enter__()
         try:
             if self.comp is None:
                 self.start()
-            while not self._stop.is_set():
+            while not self._stop.is_set() and not signals.caught:
                 comp = self._component()
                 if not comp.exists:
                     log.info("%s: component removed, stopping",
@@ -327,8 +323,7 @@ class Bridge:
                 self._stop.wait(self.cfg.poll)
         finally:
             self.shutdown()
-            for sig, handler in old.items():
-                signal.signal(sig, handler)
+            signals.__exit__(None, None, None)
 
     def stop(self) -> None:
         self._stop.set()

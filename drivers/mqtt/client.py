@@ -138,7 +138,14 @@ class Link:
         """Say goodbye and end the network thread (bounded wait)."""
         client = self.client
         if self.up and self.status_topic:
-            client.publish(self.status_topic, "offline", qos=0, retain=True)
+            # acknowledged before the disconnect: a clean disconnect
+            # does not send the last will, so this must not be lost
+            info = client.publish(self.status_topic, "offline", qos=1,
+                                  retain=True)
+            try:
+                info.wait_for_publish(min(timeout, 1.0))
+            except (RuntimeError, ValueError):
+                pass            # not connected: the broker has the will
         client.disconnect()
         ender = threading.Thread(target=client.loop_stop, daemon=True,
                                  name="mqtt-stop")

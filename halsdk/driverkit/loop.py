@@ -4,7 +4,6 @@ statistics, reconnect with exponential back-off, stop on a signal."""
 from __future__ import annotations
 
 import math
-import signal
 import threading
 import time
 from typing import Callable, Optional
@@ -19,6 +18,7 @@ from halsdk.driverkit.base import (
     DriverError,
     log,
 )
+from halsdk.driverkit.signals import StopSignals
 from halsdk.errors import HalError
 
 #: the longest cycle of a loop, in seconds
@@ -129,11 +129,7 @@ class IOLoop:
         (:meth:`Driver.safe_state`), close it and remove the component.
         For ``loadusr`` processes; a component that cannot be created
         ends the process with a message and status 1."""
-        old = {}
-        if handle_signals and threading.current_thread() is \
-                threading.main_thread():
-            for sig in (signal.SIGTERM, signal.SIGINT):
-                old[sig] = signal.signal(sig, lambda *_: self.stop())
+        signals = StopSignals(handle_signals).__enter__()
         try:
             try:
                 self.start()
@@ -142,7 +138,7 @@ class IOLoop:
                           self.driver.prefix, exc)
                 raise SystemExit(1) from None
             deadline = self.clock()
-            while not self._stop.is_set():
+            while not self._stop.is_set() and not signals.caught:
                 comp = self.driver.comp
                 if comp is None or not comp.exists:
                     log.warning("%s: component removed, stopping",
@@ -167,8 +163,7 @@ class IOLoop:
                 self.connected = False
                 self.go_safe()
             self.driver.shutdown()
-            for sig, handler in old.items():
-                signal.signal(sig, handler)
+            signals.__exit__(None, None, None)
 
     def go_safe(self) -> None:
         """Call the driver's :meth:`Driver.safe_state`; an error is

@@ -331,3 +331,17 @@ def test_thread_made_while_running_starts_at_once(hal):
     finally:
         hal.stop()
     assert not hal.thread("late").running
+
+
+@pytest.mark.parametrize("nfuncts", [1, 2, 3, 6, 17])
+def test_delthread_of_a_thread_with_many_functions(hal, nfuncts):
+    """Deleting a thread drops its whole function list; the bounded walk
+    of that list must not take the shrinking count for damage."""
+    hal.newthread("busy", 1_000_000)
+    hal.loadrt("and2", count=nfuncts)
+    for k in range(nfuncts):
+        hal.addf(f"and2.{k}", "busy")
+    hal.delthread("busy")
+    assert hal.threads() == []
+    assert all(f.users == 0 for f in hal.functions())
+    hal.check()

@@ -159,7 +159,7 @@ def test_mqtt_bridge_publishes_offline_and_ends_when_host_is_sigkilled(
         hosts.pids.append(pid)
         host_pid = host.proc.pid
         host.kill()
-        assert status.wait("offline", 10)
+        assert status.wait("offline", 10), host.stderr()
         assert wait_ended(pid, 10) < 2 * BOUND      # disconnects first
     finally:
         status.close()

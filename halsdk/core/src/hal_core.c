@@ -1719,6 +1719,7 @@ static int drop_entries(hal_thread_t *t, hoff_t fo)
             *link = e->next;
             hal_free(e);
             t->nfuncts--;
+            steps--;            /* the list is one shorter: still bounded */
             n++;
         } else {
             link = &e->next;
