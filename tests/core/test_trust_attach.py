@@ -14,7 +14,6 @@ also the ones given away.
 from __future__ import annotations
 
 import os
-import pwd
 import stat
 import subprocess
 import sys
@@ -23,6 +22,7 @@ from pathlib import Path
 from typing import Optional
 
 import pytest
+from helpers.users import OTHER, needs_root
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -33,21 +33,6 @@ from halsdk.errors import InstanceError, TrustError
 SHM_DIR = "/dev/shm"
 BIN = Path(sys.executable).parent
 
-needs_root = pytest.mark.skipif(os.geteuid() != 0,
-                                reason="giving files to another user "
-                                       "needs root")
-
-
-def _unused_uid() -> int:
-    for uid in range(12345, 12445):
-        try:
-            pwd.getpwuid(uid)
-        except KeyError:
-            return uid
-    raise RuntimeError("no unused uid in 12345..12444")
-
-
-OTHER = _unused_uid()
 
 
 def segment(name: str) -> str:

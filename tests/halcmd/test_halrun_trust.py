@@ -11,34 +11,19 @@ away); every file made here is removed at the end.
 from __future__ import annotations
 
 import os
-import pwd
 import subprocess
 import sys
 import time
 from pathlib import Path
 
 import pytest
+from helpers.users import OTHER, needs_root
 
 import halsdk
 
 BIN = Path(sys.executable).parent
 SHM_DIR = "/dev/shm"
 
-needs_root = pytest.mark.skipif(os.geteuid() != 0,
-                                reason="giving files to another user "
-                                       "needs root")
-
-
-def _unused_uid() -> int:
-    for uid in range(12345, 12445):
-        try:
-            pwd.getpwuid(uid)
-        except KeyError:
-            return uid
-    raise RuntimeError("no unused uid in 12345..12444")
-
-
-OTHER = _unused_uid()
 
 
 def halrun(args: list[str], cwd: Path,
