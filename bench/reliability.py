@@ -188,6 +188,22 @@ def fuzz(kind_name: str, count: int, seed: int, jobs: int) -> Tally:
     return tally
 
 
+def _tally_of(kind: str, result: dict[str, Any]) -> Tally:
+    """A Tally from the counts that segment_fuzz and killtests return."""
+    return Tally(kind, result["inputs"], result["crashes"],
+                 result["tracebacks"], result["hangs"], result["leftovers"],
+                 result["seconds"], list(result.get("findings", []))[:5])
+
+
+def _report(tally: Tally, unit: str) -> None:
+    print(f"{tally.kind}: {tally.inputs} {unit}, {tally.crashes} crashes, "
+          f"{tally.tracebacks} tracebacks, {tally.hangs} hangs, "
+          f"{tally.leftovers} leftovers in {tally.seconds:.0f} s",
+          flush=True)
+    for finding in tally.findings:
+        print(f"    {finding}", flush=True)
+
+
 def _table(tallies: Sequence[Tally]) -> str:
     rows = ["| kind | inputs | crashes | tracebacks | hangs | leftovers "
             "| time |", "|---|---:|---:|---:|---:|---:|---:|"]
@@ -224,22 +240,12 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     for name in names:
         if name == "shm":
             import segment_fuzz
-            tally = Tally("shm")
-            result = segment_fuzz.campaign(args.count, seed=args.seed,
-                                           jobs=args.jobs)
-            for key in ("inputs", "crashes", "tracebacks", "hangs",
-                        "leftovers", "seconds"):
-                setattr(tally, key, result[key])
-            tally.findings = list(result.get("findings", []))[:5]
+            tally = _tally_of("shm", segment_fuzz.campaign(
+                args.count, seed=args.seed, jobs=args.jobs))
         else:
             tally = fuzz(name, args.count, args.seed, args.jobs)
         tallies.append(tally)
-        print(f"{name}: {tally.inputs} inputs, {tally.crashes} crashes, "
-              f"{tally.tracebacks} tracebacks, {tally.hangs} hangs, "
-              f"{tally.leftovers} leftovers in {tally.seconds:.0f} s",
-              flush=True)
-        for finding in tally.findings:
-            print(f"    {finding}", flush=True)
+        _report(tally, "inputs")
     targets = [t for t in args.kill_targets.split(",") if t and t != "none"]
     for target in targets:
         if target not in ("host", "component", "halcmd", "client"):
@@ -249,20 +255,12 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         import killtests
         for target in targets:
             for signame in ("SIGKILL", "SIGSTOP"):
-                res = killtests.campaign(target, signame, args.kills,
-                                         seed=args.seed, jobs=args.jobs)
-                tally = Tally(f"kill {target} ({signame})")
-                for key in ("inputs", "crashes", "tracebacks", "hangs",
-                            "leftovers", "seconds"):
-                    setattr(tally, key, res[key])
-                tally.findings = list(res["findings"])[:5]
+                tally = _tally_of(
+                    f"kill {target} ({signame})",
+                    killtests.campaign(target, signame, args.kills,
+                                       seed=args.seed, jobs=args.jobs))
                 tallies.append(tally)
-                print(f"{tally.kind}: {tally.inputs} runs, {tally.crashes} "
-                      f"crashes, {tally.tracebacks} tracebacks, "
-                      f"{tally.hangs} hangs, {tally.leftovers} leftovers "
-                      f"in {tally.seconds:.0f} s", flush=True)
-                for finding in tally.findings:
-                    print(f"    {finding}", flush=True)
+                _report(tally, "runs")
     if args.markdown:
         print()
         print(_table(tallies))
