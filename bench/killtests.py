@@ -18,7 +18,9 @@ or SIGSTOP to the target's process, then checks what a user expects:
 * nobody else crashes (no process ends by SIGSEGV, SIGBUS, SIGABRT,
   SIGILL or SIGFPE) and nothing prints a traceback;
 * nothing hangs: with a dead host every other program ends within
-  HOST_GONE_SECONDS; with any other target the session still answers
+  HOST_GONE_SECONDS, and with a stopped host the userspace component
+  does (it drives outputs from pins nobody updates); with any other
+  target the session still answers
   ``halcmd show comp`` (a stopped holder of the lock gives an error
   after the lock timeout, not a wait for ever) and then ends normally
   when halrun's input closes (a stopped target is continued first);
@@ -292,8 +294,10 @@ def one(target: str, signame: str, rng: random.Random,
                 if target != "host":
                     run.halcmd("show", "comp")
                 else:
-                    # a stopped host: its clients get an answer or an
+                    # a stopped host: its userspace component ends as
+                    # for a dead host; its clients get an answer or an
                     # error, never a wait for ever
+                    run.wait_component_gone(HOST_GONE_SECONDS)
                     run.halcmd("show", "pin", "ucomp")
                 if stopped:
                     os.kill(pid, signal.SIGCONT)

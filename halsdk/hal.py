@@ -5,8 +5,9 @@ from __future__ import annotations
 import fnmatch
 import os
 import signal as _signal
+import subprocess
 import time
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from typing import Any, Callable, Optional, Union
 
 from halsdk.component import Component
@@ -132,24 +133,39 @@ class Hal:
         :meth:`end_with_host` or with a userspace component), else 0."""
         return instance.host_gone()
 
-    def child_preexec(self) -> Optional[Callable[[], None]]:
-        """A ``preexec_fn`` for a program that this process starts and
-        that must end with it: on the host's main thread, the child gets
-        SIGTERM when the host ends in any way (``PR_SET_PDEATHSIG``, which
-        the kernel ties to the starting thread); None elsewhere (an
-        attached halcmd's programs are not its children in HAL terms: a
-        halsdk program watches the host itself)."""
+    def spawn(self, argv: Sequence[str], **popen: Any
+              ) -> subprocess.Popen:
+        """Start a program (``subprocess.Popen`` arguments) that ends
+        when the host ends, however it ends (exit, crash, SIGKILL): it
+        gets SIGTERM, as a host's normal exit sends its ``loadusr``
+        programs.  On the host's main thread the kernel does it
+        (``PR_SET_PDEATHSIG``, which it ties to the starting thread);
+        elsewhere (an attached ``halcmd``, another thread of the host) a
+        small ``halsdk-guard`` process waits on pidfds of the host and the
+        program and ends with whichever ends first."""
         import threading
-        if not self._conn.host or \
-                threading.current_thread() is not threading.main_thread():
-            return None
-        parent = os.getpid()
+        on_main = self._conn.host and \
+            threading.current_thread() is threading.main_thread()
+        if on_main:
+            parent = os.getpid()
+            chained = popen.pop("preexec_fn", None)
 
-        def preexec() -> None:
-            _core.set_parent_death_signal(int(_signal.SIGTERM))
-            if os.getppid() != parent:      # the host ended already
-                os.kill(os.getpid(), _signal.SIGTERM)
-        return preexec
+            def preexec() -> None:
+                _core.set_parent_death_signal(int(_signal.SIGTERM))
+                if os.getppid() != parent:      # the host ended already
+                    os.kill(os.getpid(), _signal.SIGTERM)
+                if chained is not None:
+                    chained()
+            popen["preexec_fn"] = preexec
+        child = subprocess.Popen(list(argv), **popen)
+        if not on_main:
+            try:
+                _core.guard_child(child.pid)
+            except BaseException:
+                child.terminate()
+                child.wait()
+                raise
+        return child
 
     def _call_host(self, op: str, *args: Any, **kwargs: Any) -> Any:
         if self._conn.host:

@@ -208,6 +208,7 @@ cdef extern from "hal_core.h" nogil:
     int hal_pid_alive(int pid, uint64_t start)
     int hal_watch_host(int end_process, const char *who)
     int hal_host_gone()
+    int hal_guard_child(int child)
     int hal_comp_mark_dead(int id)
     enum:
         HAL_COMP_DEAD
@@ -1220,6 +1221,15 @@ def host_gone() -> int:
     return hal_host_gone()
 
 
+def guard_child(int pid):
+    """A program this process started (``pid``) gets SIGTERM when the
+    host ends, however it ends: a small guard process (named
+    ``halsdk-guard``) waits on pidfds of the host and the program and ends
+    with whichever ends first."""
+    need_instance()
+    check(hal_guard_child(pid))
+
+
 def comp_mark_dead(int comp_id):
     """Host: mark the userspace component of an ended process dead and
     set its out pins to zero."""
@@ -1821,14 +1831,18 @@ def thread_delete(name):
     check(r)
 
 
-def addf(funct, thread, int position=-1):
+def addf(funct, thread, position=-1):
     need_instance()
+    if not -2**31 <= position < 2**31:
+        raise _errors.InvalidError(f"addf '{funct}': position {position} "
+                                   "is out of range")
+    cdef int pos = position
     cdef bytes f = enc(funct), t = enc(thread)
     cdef const char *cf = f
     cdef const char *ct = t
     cdef int r
     with nogil:
-        r = hal_addf(cf, ct, position)
+        r = hal_addf(cf, ct, pos)
     check(r)
 
 

@@ -436,10 +436,9 @@ class CommandRunner:
             # the compat hal/linuxcnc modules importable, as the
             # reference's halrun makes its own for the programs it starts
             # and ends with the host, however the host ends
-            child = subprocess.Popen([_program_path(prog), *args[1:]],
-                                     stdin=subprocess.DEVNULL,
-                                     cwd=self.workdir, env=program_env(),
-                                     preexec_fn=self.hal.child_preexec())
+            child = self.hal.spawn([_program_path(prog), *args[1:]],
+                                   stdin=subprocess.DEVNULL,
+                                   cwd=self.workdir, env=program_env())
         except OSError as exc:
             raise CommandError(f"execv({prog}): {exc.strerror}",
                                f"program '{prog}' failed, returned 1"
@@ -803,8 +802,14 @@ class CommandRunner:
 
 
 def _atoi(text: str) -> int:
+    """C's atoi, as the reference reads these numbers: the leading
+    digits, saturated to a long, then taken as a 32-bit int
+    ("2147483648" is -2147483648)."""
     m = re.match(r"\s*([-+]?\d+)", text)
-    return int(m.group(1)) if m else 0
+    if not m:
+        return 0
+    value = max(-2**63, min(2**63 - 1, int(m.group(1))))
+    return (value + 2**31) % 2**32 - 2**31
 
 
 def _discard(text: str) -> None:

@@ -15,6 +15,7 @@ import signal
 import subprocess
 import sys
 import textwrap
+import time
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -24,6 +25,7 @@ from helpers.halcompile import child_env, halcompile
 from helpers.liveness import (
     BOUND,
     Hosts,
+    guards_of,
     hosts_fixture,
     program,
     read_pid,
@@ -107,16 +109,102 @@ def test_component_of_an_attached_halcmd_ends_with_the_host(tmp_path,
 
 def test_loadusr_program_without_hal_ends_with_its_host(tmp_path, hosts):
     """PR_SET_PDEATHSIG: any program the host started gets SIGTERM."""
-    pidfile = tmp_path / "pid"
-    script = tmp_path / "plain.sh"
-    script.write_text(f"#!/bin/sh\necho $$ > {pidfile}.tmp\n"
-                      f"mv {pidfile}.tmp {pidfile}\nexec sleep 60\n")
-    script.chmod(0o755)
+    script, pidfile = plain_program(tmp_path)
     host = hosts.make("plain", f"loadusr {script}\n")
     pid = read_pid(pidfile)
     hosts.pids.append(pid)
     host.kill()
     assert wait_ended(pid, 10) < BOUND
+
+
+def plain_program(tmp_path: Path) -> tuple[Path, Path]:
+    """A shell script that writes its pid and sleeps: no HAL in it."""
+    pidfile = tmp_path / "pid"
+    script = tmp_path / "plain.sh"
+    script.write_text(f"#!/bin/sh\necho $$ > {pidfile}.tmp\n"
+                      f"mv {pidfile}.tmp {pidfile}\nexec sleep 60\n")
+    script.chmod(0o755)
+    return script, pidfile
+
+
+def test_program_of_an_attached_halcmd_ends_with_the_host(tmp_path, hosts):
+    """``loadusr sleep 60`` from another terminal: not the host's child
+    and no HAL program, so a halsdk-guard process ends it with the host;
+    the halcmd's captured output does not wait for the guard."""
+    script, pidfile = plain_program(tmp_path)
+    host = hosts.make("attplain", "")
+    host.up()
+    with open(tmp_path / "halcmd.out", "w+") as out:
+        # the program inherits halcmd's output, as in the reference
+        subprocess.run([program("halcmd"), "loadusr", str(script)],
+                       cwd=tmp_path, env=host.env, stdout=out,
+                       stderr=subprocess.STDOUT, timeout=60, check=True)
+        out.seek(0)
+        assert "Traceback" not in out.read()
+    pid = read_pid(pidfile)
+    hosts.pids.append(pid)
+    guards = guards_of(pid)
+    assert len(guards) == 1, guards
+    hosts.pids.extend(guards)
+    host.kill()
+    assert wait_ended(pid, 10) < BOUND
+    assert wait_ended(guards[0], 10) < BOUND
+
+
+def test_guard_ends_with_its_program(tmp_path, hosts):
+    """A program that ends first leaves no guard behind, and the host
+    lives on."""
+    script, pidfile = plain_program(tmp_path)
+    host = hosts.make("guardend", "")
+    host.up()
+    subprocess.run([program("halcmd"), "loadusr", str(script)],
+                   cwd=tmp_path, env=host.env, stdout=subprocess.DEVNULL,
+                   timeout=60, check=True)
+    pid = read_pid(pidfile)
+    hosts.pids.append(pid)
+    guards = guards_of(pid)
+    assert len(guards) == 1, guards
+    hosts.pids.extend(guards)
+    os.kill(pid, signal.SIGTERM)
+    assert wait_ended(guards[0], 10) < BOUND
+    assert host.proc.poll() is None
+
+
+HOST_THREAD_PY = """\
+import sys, threading, time
+import halsdk
+hal = halsdk.Hal(sys.argv[1])
+threading.Thread(target=hal.spawn, args=([sys.argv[2]],)).start()
+time.sleep(120)
+"""
+
+
+def test_program_started_off_the_main_thread_ends_with_the_host(
+        tmp_path, hosts):
+    """PR_SET_PDEATHSIG follows the starting thread, which may end long
+    before the host: Hal.spawn from another thread uses a guard."""
+    script, pidfile = plain_program(tmp_path)
+    (tmp_path / "host.py").write_text(HOST_THREAD_PY)
+    name = tag("thread")
+    host = subprocess.Popen([sys.executable, str(tmp_path / "host.py"),
+                             name, str(script)], cwd=tmp_path,
+                            env=child_env(HALSDK_INSTANCE=name))
+    try:
+        pid = read_pid(pidfile)
+        hosts.pids.append(pid)
+        time.sleep(0.2)             # the starting thread has ended
+        assert wait_for(lambda: guards_of(pid), 10)
+        hosts.pids.extend(guards_of(pid))
+        host.kill()
+        host.wait()
+        assert wait_ended(pid, 10) < BOUND
+    finally:
+        if host.poll() is None:
+            host.kill()
+            host.wait()
+        subprocess.run([program("halrun"), "-U"], cwd=tmp_path,
+                       env=child_env(HALSDK_INSTANCE=name),
+                       capture_output=True, timeout=60)
 
 
 def test_loadusr_programs_end_when_host_exits_normally(tmp_path, hosts):
@@ -130,6 +218,58 @@ def test_loadusr_programs_end_when_host_exits_normally(tmp_path, hosts):
     host.proc.wait(20)
     assert wait_ended(pid, 10) < BOUND
     assert "Traceback" not in host.stderr()
+
+
+# ----------------------------------------------- the host is stopped
+
+
+def test_component_ends_when_its_host_is_stopped(tmp_path, hosts):
+    """A stopped host (SIGSTOP, a debugger) runs no thread: a program
+    that drives hardware from its pins ends, as with a dead host, saying
+    so; the host, continued, finds the component dead."""
+    script = write_comp(tmp_path)
+    host = hosts.make("stop", f"loadusr -Wn victim {sys.executable} "
+                      f"{script} victim {tmp_path / 'pid'}\n"
+                      "net en victim.enable\n")
+    pid = read_pid(tmp_path / "pid")
+    hosts.pids.append(pid)
+    # the host is past its loadusr -W (stopped there, it would find the
+    # program gone before it was seen ready: an error of the HAL file)
+    assert wait_for(lambda: "victim.enable" in host.halcmd(
+        "-s", "show", "sig", "en").stdout, 10)
+    host_pid = host.proc.pid
+    os.kill(host_pid, signal.SIGSTOP)
+    try:
+        assert wait_ended(pid, 10) < BOUND
+    finally:
+        os.kill(host_pid, signal.SIGCONT)
+    assert wait_for(lambda: "dead" in host.halcmd("-s", "show", "comp",
+                                                  "victim").stdout, 10)
+    assert host.halcmd("-s", "getp", "victim.enable").stdout.strip() \
+        == "FALSE"
+    text = host.stderr()
+    assert (f"comp.py: HAL instance '{tag('stop')}': its host (pid "
+            f"{host_pid}) is stopped; ending (pid {pid})") in text, text
+    assert "Traceback" not in text
+
+
+def test_a_group_stopped_and_continued_together_lives_on(tmp_path, hosts):
+    """Ctrl-Z and fg stop and continue the host and its programs
+    together: that is no stopped host, and nothing ends."""
+    script = write_comp(tmp_path)
+    host = hosts.make("group", f"loadusr -Wn victim {sys.executable} "
+                      f"{script} victim {tmp_path / 'pid'}\n",
+                      new_session=True)
+    pid = read_pid(tmp_path / "pid")
+    hosts.pids.append(pid)
+    for _ in range(5):
+        os.killpg(host.proc.pid, signal.SIGSTOP)
+        time.sleep(0.2)
+        os.killpg(host.proc.pid, signal.SIGCONT)
+        time.sleep(0.2)
+    assert host.proc.poll() is None
+    assert "ready" in host.halcmd("-s", "show", "comp", "victim").stdout
+    assert "is stopped" not in host.stderr()
 
 
 @pytest.fixture(scope="module")

@@ -2007,6 +2007,11 @@ int hal_inst_delete(const char *name)
 
 int hal_comp_exit(int id)
 {
+    /* a process ending because its host is gone or stopped: no wait for
+       a lock the host may hold; the host marks the component dead when
+       it runs again, and halrun -U removes a dead host's segment */
+    if (!hal_map.is_host && hal_host_gone())
+        return 0;
     int r = hal_lock();
     if (r)
         return r;

@@ -595,6 +595,11 @@ int hal_pidfd_open(int pid);                /* -1 and errno on failure */
 int hal_watch_host(int end_process, const char *who);
 void hal_unwatch_host(void);
 int hal_host_gone(void);                    /* its pid once ended, else 0 */
+/* a started program (pid child) gets SIGTERM when the host ends: a small
+   guard process waits on pidfds of both, for programs that
+   PR_SET_PDEATHSIG cannot cover (started by an attached process or off
+   the host's main thread) */
+int hal_guard_child(int child);
 /* the host: a userspace component whose process ended is marked dead
    and its out pins set to zero; takes the lock */
 int hal_comp_mark_dead(int id);

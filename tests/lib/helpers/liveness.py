@@ -82,7 +82,8 @@ class Host:
     """``halrun -f x.hal`` in ``cwd``, kept running by a last
     ``loadusr -w sleep 120``; its stderr goes to ``cwd/halrun.err``."""
 
-    def __init__(self, cwd: Path, name: str, hal_text: str, **env: str):
+    def __init__(self, cwd: Path, name: str, hal_text: str,
+                 new_session: bool = False, **env: str):
         self.name = name
         self.env = env_for(name, **env)
         self.cwd = cwd
@@ -90,7 +91,8 @@ class Host:
         self.err = open(cwd / "halrun.err", "w+")
         self.proc = subprocess.Popen(
             [program("halrun"), "-f", "x.hal"], cwd=cwd, env=self.env,
-            stdout=subprocess.DEVNULL, stderr=self.err)
+            stdout=subprocess.DEVNULL, stderr=self.err,
+            start_new_session=new_session)
 
     def halcmd(self, *args: str, check: bool = True
                ) -> subprocess.CompletedProcess:
@@ -141,8 +143,9 @@ class Hosts:
         self.hosts: list[Host] = []
         self.pids: list[int] = []
 
-    def make(self, name: str, hal_text: str, **env: str) -> Host:
-        host = Host(self.cwd, name, hal_text, **env)
+    def make(self, name: str, hal_text: str, new_session: bool = False,
+             **env: str) -> Host:
+        host = Host(self.cwd, name, hal_text, new_session, **env)
         self.hosts.append(host)
         return host
 
@@ -162,3 +165,24 @@ def hosts_fixture(cwd: Path) -> Iterator[Any]:
         yield hosts
     finally:
         hosts.close()
+
+
+def guards_of(pid: int) -> list[int]:
+    """The ``halsdk-guard`` processes that watch process ``pid`` (a pidfd
+    of theirs names it in /proc/<guard>/fdinfo)."""
+    found = []
+    for entry in os.listdir("/proc"):
+        if not entry.isdigit():
+            continue
+        try:
+            with open(f"/proc/{entry}/comm") as f:
+                if f.read().strip() != "halsdk-guard":
+                    continue
+            for fd in os.listdir(f"/proc/{entry}/fdinfo"):
+                with open(f"/proc/{entry}/fdinfo/{fd}") as f:
+                    if f"Pid:\t{pid}\n" in f.read():
+                        found.append(int(entry))
+                        break
+        except OSError:
+            continue
+    return found
