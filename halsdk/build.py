@@ -304,5 +304,7 @@ def _cythonize(source: str, pyx: str, c_file: str, name: str) -> None:
             Errors.close_listing_file()
     if errors or not os.path.isfile(c_file):
         # name the caller's file, not the private copy
-        _fail(source, messages.getvalue().replace(pyx, source)
-              or "Cython failed")
+        # (Cython names it relative to the working folder when it can)
+        text = messages.getvalue().replace(pyx, source) \
+            .replace(os.path.relpath(pyx), source)
+        _fail(source, text or "Cython failed")

@@ -14,6 +14,10 @@ from cantools.database.can import Database, Message, Signal
 PinValue = Union[bool, int, float]
 
 _MESSAGE_LINE = re.compile(r"^\s*BO_\s+\d+\s+(\w+)\s*:")
+_MESSAGE_SIZE = re.compile(r"^\s*BO_\s+\d+\s+(\w+)\s*:\s*(\d+)")
+_SIGNAL_BITS = re.compile(r"^\s*SG_\s+(\w+)[^:]*:\s*(\d+)\|(\d+)@")
+#: the largest CAN frame (CAN FD), in bytes
+MAX_FRAME_BYTES = 64
 
 
 class ConfigError(Exception):
@@ -59,6 +63,7 @@ def load_dbc(path: str, shown: Optional[str] = None) -> Database:
     lines = text.splitlines()
     if all(_EMPTY_LINE.match(line) for line in lines):
         raise ConfigError(f"{shown}: empty DBC file")
+    _check_sizes(lines, shown)
     try:
         db = cantools.database.load_string(text + _SENTINEL,
                                            database_format="dbc")
@@ -67,6 +72,27 @@ def load_dbc(path: str, shown: Optional[str] = None) -> Database:
     if not isinstance(db, Database):     # (typed: or a diagnostics one)
         raise ConfigError(f"{shown}: not a CAN database")
     return db
+
+
+def _check_sizes(lines: list[str], shown: str) -> None:
+    """Frame sizes and signal bits no CAN frame can hold, refused before
+    cantools lays them out (a size of 2**31 bytes would take it for
+    ever)."""
+    bits = 8 * MAX_FRAME_BYTES
+    for number, line in enumerate(lines, 1):
+        match = _MESSAGE_SIZE.match(line)
+        if match and int(match.group(2)) > MAX_FRAME_BYTES:
+            raise ConfigError(
+                f"{shown}:{number}: message {match.group(1)}: "
+                f"{match.group(2)} bytes; a CAN frame has at most "
+                f"{MAX_FRAME_BYTES}")
+        match = _SIGNAL_BITS.match(line)
+        if match and (int(match.group(2)) >= bits or
+                      int(match.group(3)) > bits):
+            raise ConfigError(
+                f"{shown}:{number}: signal {match.group(1)}: bit "
+                f"{match.group(2)}, {match.group(3)} bits; a CAN frame "
+                f"has {bits} bits")
 
 
 def _error_text(exc: Exception, path: str, shown: str,

@@ -34,6 +34,7 @@ from dataclasses import dataclass
 from typing import Any, Optional
 
 from halsdk.ini import IniFile
+from halsdk.motion.ini import MAX_JOINTS
 
 __all__ = ["IniProblem", "check_ini", "check_hal_joints", "hal_references",
            "known_keys", "section_kind", "DOCUMENTED_KEYS", "HALSDK_KEYS",
@@ -303,6 +304,10 @@ def _joint_counts(ini: IniFile) -> list[IniProblem]:
     if njoints is None:
         return out                      # motion's own check says why
     line = ini.line("KINS", "JOINTS")
+    if njoints > MAX_JOINTS:
+        return [IniProblem(ini.path, line, "KINS", "JOINTS",
+                           f"[KINS]JOINTS = {njoints} is more than "
+                           f"{MAX_JOINTS}, the most motion has")]
     numbers = sorted(int(m.group(2)) for m in map(_NUMBERED.match,
                                                   ini.section_lines)
                      if m and m.group(1) == "JOINT")

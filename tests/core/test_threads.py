@@ -95,6 +95,9 @@ def test_addf_positions(hal):
     hal.add_python_function("e", lambda p: None)
     with pytest.raises(halsdk.InvalidError, match="position"):
         hal.addf("e", "t", 9)
+    for huge in (2**31, -2**31 - 1, 10**20):    # no C int: no overflow
+        with pytest.raises(halsdk.InvalidError, match="out of range"):
+            hal.addf("e", "t", huge)
     assert hal.function("e").users == 0
     hal.delf("a", "t")
     assert hal.thread("t").functions == ["c", "d", "b"]

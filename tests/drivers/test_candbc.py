@@ -515,6 +515,19 @@ def test_truncated_empty_and_bad_cycle_dbc(tmp_path, monkeypatch):
     with pytest.raises(ConfigError, match=r"^slow.dbc:17: message "
                        "DriveCommand: cycle time 99999999999 ms"):
         parse_args(["--dbc", "slow.dbc"])
+    # sizes no frame can hold are refused at once, at their line
+    line = text[:text.index("BO_ 512 DriveCommand")].count("\n") + 1
+    (tmp_path / "huge.dbc").write_text(text.replace(
+        "BO_ 512 DriveCommand: 4", "BO_ 512 DriveCommand: 2147483647"))
+    with pytest.raises(ConfigError) as info:
+        parse_args(["--dbc", "huge.dbc"])
+    assert str(info.value) == (f"huge.dbc:{line}: message DriveCommand: "
+                               "2147483647 bytes; a CAN frame has at most 64")
+    (tmp_path / "wide.dbc").write_text(text.replace(
+        "TargetSpeed : 0|16@", "TargetSpeed : 0|99999@"))
+    with pytest.raises(ConfigError, match=r"^wide.dbc:\d+: signal "
+                       "TargetSpeed: bit 0, 99999 bits; a CAN frame has 512"):
+        parse_args(["--dbc", "wide.dbc"])
     # the whole file still loads, with every signal
     config = parse_args(["--dbc", DEMO])
     info_msg = config.db.get_message_by_name("DriveInfo")

@@ -138,6 +138,14 @@ JOINTS = 2
         "this section is not used"]
 
 
+def test_joints_beyond_what_motion_has_is_one_problem(tmp_path):
+    """A count no motion has: one line at once (no list of 2**31 missing
+    sections, nor the time to make it)."""
+    found = problems(tmp_path, "[KINS]\nJOINTS = 2147483647\n[JOINT_0]\n")
+    assert found == [f"{tmp_path}/m.ini:2: [KINS]JOINTS: [KINS]JOINTS = "
+                     "2147483647 is more than 16, the most motion has"]
+
+
 # ------------------------------------------------- property: every typo
 
 SECTIONS = ["EMC", "DISPLAY", "RS274NGC", "EMCMOT", "TASK", "HAL", "HALUI",
