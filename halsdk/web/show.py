@@ -22,6 +22,7 @@ from typing import Any, Optional
 from halsdk.errors import HalError
 from halsdk.hal import Hal
 from halsdk.halcmd import CommandRunner, Quit, logical_lines, tokenize
+from halsdk.halcmd.commands import ARG_COUNTS
 from halsdk.halcmd.show import value_text
 from halsdk.types import Direction, dir_word, type_word
 
@@ -63,6 +64,21 @@ def value_json(type_: int, value: Any) -> str:
 
 def _dir(d: int) -> str:
     return dir_word(d).strip()
+
+
+class _PageRunner(CommandRunner):
+    """halcmd's runner for the words of a page's change: a command and
+    its arguments, never the ``NAME = VALUE`` form of the language (a
+    signal may be named ``=``: ``sets = 1`` sets it)."""
+
+    def dispatch(self, words: list[str]) -> None:
+        cmd = words[0]
+        if len(words) == 3 and words[1] == "=" and cmd in ARG_COUNTS:
+            least, most = ARG_COUNTS[cmd]
+            if least <= 2 and (most is None or most >= 2):
+                getattr(self, "cmd_" + cmd)(words[1:])
+                return
+        super().dispatch(words)
 
 
 class Show:
@@ -230,8 +246,8 @@ class Show:
         self._allowed(words)
         out: list[str] = []
         err: list[str] = []
-        runner = CommandRunner(self.hal, out=out.append, err=err.append,
-                               register=False)
+        runner = _PageRunner(self.hal, out=out.append, err=err.append,
+                             register=False)
         try:
             ok = runner.run_words(list(words))
         except Quit:
