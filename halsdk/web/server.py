@@ -93,8 +93,8 @@ def main(argv: Optional[list[str]] = None) -> int:
     try:
         hal = Hal(a.instance, create=False)
     except HalError as exc:
-        print(f"{PROG}: no HAL instance to attach to: {exc}",
-              file=sys.stderr)
+        # "no HAL instance 'NAME' is running (start one with ...)"
+        print(f"{PROG}: {exc}", file=sys.stderr)
         return 1
     try:
         return _serve(hal, a, token)
