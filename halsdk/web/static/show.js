@@ -355,7 +355,7 @@ async function openDetail(kind, name) {
   if (VALUE_KINDS.has(kind)) {
     box.append(el("button", {type: "button", onclick: () => addWatch(key)}, "watch"));
   }
-  if (kind === "pin" || kind === "param") {
+  if ((kind === "pin" && d.dir !== "OUT") || (kind === "param" && d.dir !== "RO")) {
     box.append(actionForm("setp", [["value", "new value"]],
                           (v) => change("setp", {name, value: v.value})));
   }
