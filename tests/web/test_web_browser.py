@@ -238,3 +238,34 @@ def test_read_only_refuses_a_setp(browser, machine, tmp_path):
     finally:
         _stop(proc)
     assert machine.getp("and2.1.in1") is False
+
+
+def test_the_picture_of_the_docs(page, machine, tmp_path):
+    """The Show page as docs/web.rst shows it; written to the folder
+    ``$HALSDK_DOCS_SCREENSHOTS`` names, when set (``docs`` refreshes the
+    picture of the page)."""
+    machine.loadrt("siggen")
+    machine.addf("siggen.0.update", "servo", 1)
+    machine.net("wave", "siggen.0.sine")
+    machine.start()
+    page.set_viewport_size({"width": 1200, "height": 700})
+    page.reload()
+    page.locator("#link", has_text="live").wait_for(timeout=20_000)
+    _open(page, "Pins", "siggen (", "siggen.0 (")
+    _row(page, "pin:siggen.0.sine").click()
+    page.locator("#detail button", has_text="watch").click()
+    page.fill("#cmdline", "show thread")
+    page.click("#cmdform button")
+    page.locator("#cmdout", has_text="siggen.0.update").wait_for()
+    # the sine moves: its value on the page changes while we look
+    cell = page.locator('#watch [data-item="pin:siggen.0.sine"] .value')
+    first = cell.text_content()
+    page.wait_for_function(
+        "(t) => document.querySelector('#watch .value').textContent !== t",
+        arg=first, timeout=10_000)
+    picture = tmp_path / "web-show.png"
+    page.screenshot(path=str(picture))
+    assert picture.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    folder = os.environ.get("HALSDK_DOCS_SCREENSHOTS")
+    if folder:
+        shutil.copyfile(picture, Path(folder) / "web-show.png")

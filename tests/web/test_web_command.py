@@ -6,6 +6,8 @@ from __future__ import annotations
 import json
 import os
 import queue
+import re
+import shlex
 import signal
 import subprocess
 import sys
@@ -19,6 +21,8 @@ from pathlib import Path
 from urllib.parse import urlsplit
 
 import pytest
+from helpers import repo_path
+from helpers.docblocks import code_blocks
 from helpers.polling import wait_for
 from helpers.running_machine import halsdk_command
 
@@ -87,6 +91,11 @@ def _start(env: dict, cwd: Path, *args: str) -> subprocess.Popen:
 
 def _url(proc: subprocess.Popen, timeout: float = 60) -> str:
     """The URL the program prints (it has started serving then)."""
+    return _greeting(proc, timeout)[-1]
+
+
+def _greeting(proc: subprocess.Popen, timeout: float = 60) -> list[str]:
+    """The lines the program prints up to its URL."""
     lines: queue.Queue = queue.Queue()
 
     def read() -> None:
@@ -98,16 +107,17 @@ def _url(proc: subprocess.Popen, timeout: float = 60) -> str:
         lines.put("")
 
     threading.Thread(target=read, daemon=True).start()
-    seen = ""
+    seen: list[str] = []
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:
         try:
             line = lines.get(timeout=max(0.0, deadline - time.monotonic()))
         except queue.Empty:
             break
-        seen += line
+        seen.append(line.rstrip("\n"))
         if "http://" in line:
-            return line.strip()
+            seen[-1] = seen[-1].strip()
+            return seen
         if not line:
             break
     _end(proc)
@@ -210,3 +220,38 @@ def test_it_ends_with_its_host(halrun, tmp_path):
         _end(proc)
     assert proc.returncode == 0, err
     assert "Traceback" not in err
+
+
+def _normal(lines: list[str], command: str) -> list[str]:
+    """The greeting without what differs from run to run: the instance,
+    and the port and token unless the command gives them."""
+    out = []
+    for line in lines:
+        line = re.sub(r"instance '[^']*'", "instance 'NAME'", line.strip())
+        if "--port" not in command:
+            line = re.sub(r":\d+/", ":PORT/", line)
+        if "--token" not in command:
+            line = re.sub(r"token=[\w-]{32}$", "token=TOKEN", line)
+        out.append(line)
+    return out
+
+
+def test_the_examples_of_the_docs_run(halrun, tmp_path):
+    """The console blocks of docs/web.rst, run as the page types them;
+    they print what the page shows and serve the page."""
+    blocks = code_blocks(repo_path("docs", "web.rst"), "console")
+    assert len(blocks) == 2
+    for block in blocks:
+        command, *shown = block.splitlines()
+        assert command.startswith("$ halsdk web")
+        proc = _start(halrun, tmp_path, *shlex.split(command)[3:])
+        try:
+            printed = _greeting(proc)
+            assert _normal(printed, command) == _normal(shown, command)
+            page = _opener().open(printed[-1], timeout=30)
+            assert page.status == 200
+            os.kill(proc.pid, signal.SIGTERM)
+            proc.communicate(timeout=30)
+        finally:
+            _end(proc)
+        assert proc.returncode == 0
