@@ -231,12 +231,6 @@ class Show:
                 out[key] = None
         return out
 
-    def forget(self, keep: Iterable[str]) -> None:
-        """Drop the cached handles of keys no page watches any more."""
-        keep = set(keep)
-        for key in [k for k in self._handles if k not in keep]:
-            del self._handles[key]
-
     # ------------------------------------------------------------ changes
 
     def run_words(self, words: list[str]) -> dict[str, Any]:

@@ -176,6 +176,11 @@ def test_the_tree_lists_the_instance(client, hal):
     assert "and2" in {c["name"] for c in tree["components"]}
     assert {p["name"] for p in tree["params"]} == {
         p.name for p in hal.params()}
+    assert client.get("/api/values", params=[
+        ("key", "pin:and2.0.in0"), ("key", "signal:x-in"),
+        ("key", "param:no.such")]).json() == {
+        "pin:and2.0.in0": "FALSE", "signal:x-in": "FALSE",
+        "param:no.such": None}
 
 
 def test_the_detail_views(client, hal):

@@ -255,3 +255,24 @@ def test_the_examples_of_the_docs_run(halrun, tmp_path):
         finally:
             _end(proc)
         assert proc.returncode == 0
+
+
+def test_sigterm_ends_it_with_a_page_connected(halrun, tmp_path):
+    """An open websocket (a page watching values) does not hold the
+    server: SIGTERM still ends it, with 0."""
+    from websockets.sync.client import connect
+    proc = _start(halrun, tmp_path)
+    try:
+        parts = urlsplit(_url(proc))
+        base = f"http://127.0.0.1:{parts.port}"
+        with connect(f"ws://127.0.0.1:{parts.port}/ws?{parts.query}",
+                     origin=base, open_timeout=30) as ws:
+            ws.send(json.dumps({"watch": ["pin:and2.0.in0"]}))
+            assert json.loads(ws.recv(timeout=30)) == {
+                "values": {"pin:and2.0.in0": "FALSE"}}
+            os.kill(proc.pid, signal.SIGTERM)
+            out, err = proc.communicate(timeout=30)
+    finally:
+        _end(proc)
+    assert proc.returncode == 0, err
+    assert "Traceback" not in err
