@@ -80,6 +80,14 @@ def listen(host: str, port: int) -> socket.socket:
     return sock
 
 
+def _loopback(sock: socket.socket) -> bool:
+    """True when ``sock`` listens on a loopback address only."""
+    try:
+        return ipaddress.ip_address(sock.getsockname()[0]).is_loopback
+    except ValueError:
+        return False
+
+
 def main(argv: Optional[list[str]] = None) -> int:
     a = parser().parse_args(argv)
     token = a.token or os.environ.get("HALSDK_WEB_TOKEN") or \
@@ -141,6 +149,10 @@ def _serve(hal: Any, a: argparse.Namespace, token: str) -> int:
             signal.signal(sig, server.stop)
     # the host's end ends this server too (SIGTERM, as above)
     hal.end_with_host(PROG)
+    if not _loopback(sock):
+        print(f"{PROG}: listening on {a.host}, not only this computer: "
+              "the token travels in plain HTTP (docs/web.rst, Security)",
+              file=sys.stderr)
     mode = " (read-only)" if a.read_only else ""
     print(f"HAL workbench of instance '{hal.instance}'{mode}; open:\n"
           f"    http://{url_host(a.host)}:{port}/?token={token}",

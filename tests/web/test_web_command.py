@@ -9,6 +9,7 @@ import queue
 import re
 import shlex
 import signal
+import socket
 import subprocess
 import sys
 import threading
@@ -276,3 +277,17 @@ def test_sigterm_ends_it_with_a_page_connected(halrun, tmp_path):
         _end(proc)
     assert proc.returncode == 0, err
     assert "Traceback" not in err
+
+
+def test_a_port_in_use_is_one_line_and_exit_1(halrun, tmp_path):
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen(1)
+        port = taken.getsockname()[1]
+        proc = subprocess.run(halsdk_command() + ["web", "--port", str(port)],
+                              cwd=tmp_path, env=halrun, capture_output=True,
+                              text=True, timeout=60)
+    assert proc.returncode == 1 and proc.stdout == ""
+    assert proc.stderr.startswith(f"halsdk web: cannot listen on "
+                                  f"127.0.0.1:{port}: ")
+    assert proc.stderr.count("\n") == 1 and "Traceback" not in proc.stderr
