@@ -21,8 +21,9 @@ from typing import Any, Optional
 
 from halsdk.errors import HalError
 from halsdk.hal import Hal
-from halsdk.halcmd import CommandRunner, Quit, logical_lines, tokenize
+from halsdk.halcmd import CommandRunner, Quit, logical_lines
 from halsdk.halcmd.commands import ARG_COUNTS
+from halsdk.halcmd.lexer import SubstitutionError, split_words, strip_comment
 from halsdk.halcmd.show import value_text
 from halsdk.types import Direction, dir_word, type_word
 
@@ -251,9 +252,18 @@ class Show:
     def command(self, text: str) -> dict[str, Any]:
         """Run the lines of halcmd's command line; stops at the first
         line that fails.  Every line is checked (read-only, refused
-        commands) before any runs."""
-        lines = [words for _, line in logical_lines(text.splitlines(True))
-                 if (words := tokenize(line, None))]
+        commands) before any runs.
+
+        The words are not substituted: ``$NAME`` and ``[SECTION]KEY``
+        stay as they are typed, since the server's environment (which
+        may hold secrets) and INI file are not the page's."""
+        try:
+            lines = [words for _, line in logical_lines(
+                text.splitlines(True))
+                if (words := split_words(strip_comment(
+                    line.split("\0", 1)[0])))]
+        except SubstitutionError as exc:      # an unterminated quote
+            return {"ok": False, "output": "", "error": f"{exc}\n"}
         for words in lines:
             self._allowed(words)
         out: list[str] = []

@@ -6,6 +6,7 @@ its changes (halcmd's words on refusal) and the websocket of live values.
 from __future__ import annotations
 
 import json
+import os
 import re
 import subprocess
 import sys
@@ -305,6 +306,23 @@ def test_the_command_line_runs_halcmd(client, hal):
                     headers=ORIGIN)
     assert (r.status_code, r.json()["error"]) == (
         409, "Unknown command 'frobnicate'\n")
+
+
+def test_the_command_line_substitutes_nothing(client, monkeypatch):
+    """The server's environment is not the page's: ``$NAME`` is a word
+    as typed (halcmd would put the variable's value there)."""
+    monkeypatch.setenv("HALSDK_WEB_TEST_SECRET", "hunter2")
+    for line in ["help $HALSDK_WEB_TEST_SECRET", "getp $(HOME)",
+                 "print $HALSDK_WEB_TEST_SECRET", "getp [EMC]MACHINE"]:
+        r = client.post("/api/command", json={"line": line}, headers=ORIGIN)
+        assert r.status_code in (200, 409), line
+        text = r.json()["output"] + r.json()["error"]
+        assert "hunter2" not in text and os.environ["HOME"] not in text
+        assert line.split()[1] in text, (line, text)
+    r = client.post("/api/command", json={"line": 'echo "open'},
+                    headers=ORIGIN)
+    assert (r.status_code, r.json()["error"]) == (
+        409, "unterminated quoted string\n")
 
 
 @pytest.mark.parametrize("line", ["loadusr -W sleep 100", "waitusr x",
