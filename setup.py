@@ -164,7 +164,7 @@ setup(
     packages=["halsdk", "halsdk.core", "halsdk.compat", "halsdk.demo", "halsdk.halcmd",
               "halsdk.components", "halsdk.gcode", "halsdk.machine",
               "halsdk.motion", "halsdk.tools", "halsdk.channels", "halcompile",
-              "halsdk.driverkit", "halsdk.drivers",
+              "halsdk.driverkit", "halsdk.drivers", "halsdk.web",
               *python_drivers()],
     package_dir={"halsdk.components": "components",
                  "halsdk.drivers": "drivers"},

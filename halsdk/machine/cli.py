@@ -1,6 +1,7 @@
 """The ``halsdk`` command: ``halsdk run machine.ini`` starts a machine,
 ``halsdk ctl ...`` operates it from another shell, ``halsdk runtests
-DIR...`` runs HAL tests written in LinuxCNC's test-folder format."""
+DIR...`` runs HAL tests written in LinuxCNC's test-folder format,
+``halsdk web`` serves the HAL workbench in a browser."""
 
 from __future__ import annotations
 
@@ -26,6 +27,9 @@ def _main(argv: Optional[list[str]] = None) -> int:
     if args and args[0] == "runtests":
         from halsdk.tools.runtests import main as runtests_main
         return runtests_main(args[1:])
+    if args and args[0] == "web":
+        from halsdk.web.server import main as web_main
+        return web_main(args[1:])
     p = argparse.ArgumentParser(prog="halsdk", description=__doc__)
     sub = p.add_subparsers(dest="command", required=True)
     sub.add_parser("ctl", add_help=False,
@@ -35,6 +39,9 @@ def _main(argv: Optional[list[str]] = None) -> int:
                    help="run HAL tests in LinuxCNC's format (test.hal or "
                         "test.sh + expected or checkresult) "
                         "(halsdk runtests --help)")
+    sub.add_parser("web", add_help=False,
+                   help="serve the HAL workbench of the running instance "
+                        "in a browser (halsdk web --help)")
     run = sub.add_parser(
         "run", help="start a machine from its INI file; Ctrl-C stops it")
     run.add_argument("ini", help="the machine's INI file")

@@ -28,7 +28,7 @@ PAGES = ["index", "concepts", "tutorial", "components", "halcmd", "runtests",
          "driver-realtime", "driver-sim-io", "driver-cia402", "driver-whb04b",
          "driver-mqtt", "driver-candbc", "driver-mb2hal", "homing",
          "kinematics", "architecture", "design", "compat", "benchmarks",
-         "reliability"]
+         "reliability", "web"]
 
 
 @pytest.fixture(scope="module")

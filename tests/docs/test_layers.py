@@ -28,8 +28,8 @@ COMPONENTS, DRIVERS, COMPILER = "components", "drivers", "halcompile"
 SUBPACKAGES = {
     "core": CORE,
     "halcmd": TOOLS, "tools": TOOLS, "compat": TOOLS, "driverkit": TOOLS,
-    "web": TOOLS, "channels": TOOLS,
-    "machine": APPS, "motion": APPS, "gcode": APPS, "demo": APPS,
+    "channels": TOOLS,
+    "machine": APPS, "web": APPS, "motion": APPS, "gcode": APPS, "demo": APPS,
     "components": COMPONENTS, "drivers": DRIVERS,
 }
 
@@ -162,6 +162,8 @@ def test_no_layer_imports_a_higher_one():
     ("halsdk.motion.client", "halsdk.halcmd", True),
     ("halsdk.hal", "halsdk.halcmd", False),
     ("halsdk.compat.hal", "halsdk.machine", False),
+    ("halsdk.web.show", "halsdk.halcmd", True),
+    ("halsdk.web.app", "halsdk.core", False),
     ("halsdk.components.threads", "halsdk.core", False),
     ("halsdk.drivers.mqtt.bridge", "halsdk.driverkit", True),
     ("halsdk.userspace", "halcompile.gen_user", False),
