@@ -23,7 +23,7 @@ import asyncio
 import contextlib
 import json
 import secrets
-from collections.abc import AsyncIterator
+from collections.abc import AsyncIterator, Awaitable
 from concurrent.futures import ThreadPoolExecutor
 from functools import partial
 from http.cookies import CookieError, SimpleCookie
@@ -278,25 +278,28 @@ def create_app(hal: Hal, *, token: str, read_only: bool = False) -> Starlette:
         if read_only:
             return _refused(f"{action}: read-only: this workbench was "
                             "started with --read-only and changes nothing")
-        try:
+
+        async def run() -> dict[str, Any]:
             words = ACTIONS[action](await _body(request))
-            result = await bench.call(bench.show.run_words, words)
-        except (PermissionError, Refused) as exc:
-            return _refused(str(exc))
-        except ValueError as exc:
-            return _json({"ok": False, "output": "", "error": f"{exc}\n"},
-                         400)
-        return _json(result, 200 if result["ok"] else 409)
+            return await bench.call(bench.show.run_words, words)
+        return await _answer(run)
 
     async def command(request: Request) -> Response:
         """The command line; read-only still runs the commands that only
         read (show, getp, ...)."""
-        try:
-            data = await _body(request)
-            line = data.get("line")
+        async def run() -> dict[str, Any]:
+            line = (await _body(request)).get("line")
             if not isinstance(line, str):
                 raise ValueError("'line' is missing or not a string")
-            result = await bench.call(bench.show.command, line)
+            return await bench.call(bench.show.command, line)
+        return await _answer(run)
+
+    async def _answer(run: Callable[[], Awaitable[dict[str, Any]]]
+                      ) -> Response:
+        """The reply to a change or a command: 403 refused, 400 a bad
+        request, else its result (409 when halcmd said no)."""
+        try:
+            result = await run()
         except (PermissionError, Refused) as exc:
             return _refused(str(exc))
         except ValueError as exc:
