@@ -363,8 +363,8 @@ def _take_over(shm: str, label: str, pid: int) -> bool:
             state, now_pid, start, _abi = _core.probe(shm)
             if state != "ok" or _core.pid_alive(now_pid, start):
                 return True     # another process took it over: attach
+            channel.remove_socket(shm)      # first, as in cleanup()
             os.unlink(path)
-            channel.remove_socket(shm)
             print(f"halsdk: HAL instance '{label}': its host (pid {pid}) "
                   "is gone; taking the instance over", file=sys.stderr)
         return True
@@ -498,6 +498,11 @@ def cleanup(instance: Optional[str] = None,
             continue
         if state in ("creating", "junk") and not _older_than(n, 10.0):
             continue            # perhaps being created right now
+        # the sockets first, the segment last: whoever finds the segment
+        # gone (another halrun -U at the same time) finds its sockets
+        # gone too
+        if sockets is not None:
+            channel.remove_socket(shm, sockets)
         try:
             os.unlink(os.path.join(SHM_DIR, n))
             removed.append(n)
@@ -505,7 +510,4 @@ def cleanup(instance: Optional[str] = None,
             pass
         except OSError as exc:
             say(f"cannot remove {SHM_DIR}/{n}: {exc.strerror or exc}")
-            continue
-        if sockets is not None:
-            channel.remove_socket(shm, sockets)
     return removed

@@ -693,9 +693,20 @@ def test_stale_instance_is_reported_and_cleaned_up(no_connection, spawn,
             return names
 
         monkeypatch.setattr(os, "listdir", listdir)
+        # the sockets go first, the segment last: another halrun -U that
+        # finds the segment gone must find its sockets gone too
+        unlinked: list[str] = []
+        real_unlink = os.unlink
+
+        def unlink(path: str, *args: Any, **kw: Any) -> None:
+            real_unlink(path, *args, **kw)
+            unlinked.append(os.path.basename(path))
+
+        monkeypatch.setattr(os, "unlink", unlink)
         removed = halsdk.cleanup()
         monkeypatch.undo()
         assert removed == [halsdk.core.instance.shm_name(stale)[1:]]
+        assert unlinked == [os.path.basename(stale_socket), removed[0]]
         assert not os.path.exists(segment_file(stale))
         assert not os.path.exists(stale_socket)
         assert os.path.exists(segment_file(live))
