@@ -190,9 +190,25 @@ def _heap_start_wild(host: Any) -> None:
     _put(host, host.layout.fields["heap_start"], 0xFFFFFF00)
 
 
+def _pin_type_wild(host: Any) -> None:
+    # the listings set it (setp pid.0.Igain): a type of -1 is damage,
+    # not a value to coerce (a ValueError traceback before)
+    rec = _record(host, K_PIN, "pid.0.Igain")
+    word = _field(host, rec, 3)                     # type, dir (int16)
+    _put(host, word, (_u32(host, word) & 0xFFFF0000) | 0xFFFF)
+
+
+def _mutex_kind_wild(host: Any) -> None:
+    # glibc took the mutex for a priority-protect one and aborted the
+    # process inside pthread_mutex_lock (found by the campaign)
+    moff, _size = host.layout.fields["mutex"]
+    _put(host, moff + 16, 0x100EC0)                 # __data.__kind
+
+
 CASES = [_pin_list_out_of_segment, _pin_list_cycle, _pin_signal_wild,
          _pin_owner_wild, _alias_name_wild, _thread_functs_cycle,
-         _thread_slot_wild, _stream_huge, _bucket_wild, _heap_start_wild]
+         _thread_slot_wild, _stream_huge, _bucket_wild, _heap_start_wild,
+         _pin_type_wild, _mutex_kind_wild]
 
 
 @pytest.mark.slow

@@ -272,12 +272,42 @@ static int fail_lock_timeout(hal_header_t *h, double waited)
                     waited, comm, state ? state : '?');
 }
 
+/* the attributes of the instance mutex: shared between processes,
+   robust (a dead holder does not block the others) */
+static void instance_mutexattr(pthread_mutexattr_t *ma)
+{
+    pthread_mutexattr_init(ma);
+    pthread_mutexattr_setpshared(ma, PTHREAD_PROCESS_SHARED);
+    pthread_mutexattr_setrobust(ma, PTHREAD_MUTEX_ROBUST);
+}
+
+/* whether the mutex in the segment is still of the kind it was made:
+   a stray write into its kind word makes glibc take it for another kind
+   of mutex and abort the process inside pthread_mutex_lock */
+static int mutex_kind_ok(const pthread_mutex_t *m)
+{
+    static int want = -1;
+    if (want == -1) {
+        pthread_mutexattr_t ma;
+        pthread_mutex_t fresh;
+        instance_mutexattr(&ma);
+        pthread_mutex_init(&fresh, &ma);
+        pthread_mutexattr_destroy(&ma);
+        want = fresh.__data.__kind;
+        pthread_mutex_destroy(&fresh);
+    }
+    return __atomic_load_n(&m->__data.__kind, __ATOMIC_RELAXED) == want;
+}
+
 int hal_lock(void)
 {
     hal_header_t *h = hal_map.hdr;
     if (!h)
         return hal_fail(ENODEV, "no HAL instance is attached");
     hal_damage_take();          /* each operation reports its own */
+    if (!mutex_kind_ok(&h->mutex))
+        return hal_damaged("the instance mutex (kind %d)",
+                           h->mutex.__data.__kind);
     /* A holder may be waiting for a thread cycle that runs a Python
        function: never wait for the mutex with the GIL held.  A holder
        that is stopped (SIGSTOP) or stuck must not block this process for
@@ -317,7 +347,10 @@ void hal_unlock(void)
 {
     if (hal_map.hdr) {
         __atomic_store_n(&hal_map.hdr->lock_holder, 0, __ATOMIC_RELAXED);
-        pthread_mutex_unlock(&hal_map.hdr->mutex);
+        /* damaged while held: glibc would abort; the next hal_lock of
+           any process reports the damage */
+        if (mutex_kind_ok(&hal_map.hdr->mutex))
+            pthread_mutex_unlock(&hal_map.hdr->mutex);
     }
 }
 
@@ -1435,6 +1468,19 @@ int hal_check_settable(const hal_obj_t *o, int flags)
     hal_header_t *h = hal_map.hdr;
     if (!h)
         return hal_fail(ENODEV, "no HAL instance is attached");
+    /* the type and direction say how the value is written: a stray
+       write there is damage, not a value to coerce */
+    if (o->kind == K_PIN || o->kind == K_PARAM) {
+        const hal_item_t *it = (const hal_item_t *)o;
+        if (!hal_shape_ok(o->kind, it->type, it->dir))
+            return hal_damaged("%s '%s': type %d, direction %d",
+                               kind_word(o->kind), o->name, it->type,
+                               it->dir);
+    } else if (o->kind == K_SIG &&
+               !hal_shape_ok(K_SIG, ((const hal_sig_t *)o)->type, 0)) {
+        return hal_damaged("signal '%s': type %d", o->name,
+                           ((const hal_sig_t *)o)->type);
+    }
     if (!(flags & HAL_SET_IGNORE_LOCK) && (h->lock & HAL_LOCK_PARAMS))
         return hal_rule(hal_fail(EPERM, "cannot set %s '%s': HAL is locked "
                                  "against setting values",
@@ -2477,9 +2523,7 @@ int hal_instance_create(const char *shm_name, const char *instance,
     h->size = size;
     snprintf(h->instance, sizeof(h->instance), "%s", instance);
     pthread_mutexattr_t ma;
-    pthread_mutexattr_init(&ma);
-    pthread_mutexattr_setpshared(&ma, PTHREAD_PROCESS_SHARED);
-    pthread_mutexattr_setrobust(&ma, PTHREAD_MUTEX_ROBUST);
+    instance_mutexattr(&ma);
     pthread_mutex_init(&h->mutex, &ma);
     pthread_mutexattr_destroy(&ma);
     h->host_pid = getpid();
