@@ -19,6 +19,7 @@ import os
 import struct
 import subprocess
 import sys
+import time
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -225,6 +226,50 @@ def test_known_damage_is_reported(host: Any, damage: Any) -> None:
 def test_the_restored_segment_lists_cleanly(host: Any) -> None:
     errors = _check_listings(host)
     assert errors == ["", ""]
+
+
+VICTIM = """\
+import time
+from halsdk.compat import hal
+c = hal.component("victim")
+c.newpin("out", hal.HAL_BIT, hal.HAL_OUT)
+c["out"] = True
+c.ready()
+print("up", flush=True)
+time.sleep(120)
+"""
+
+
+def test_host_marks_a_dead_component_on_a_damaged_list(
+        tmp_path: Path) -> None:
+    """The host's watch marks a SIGKILLed component dead by walking the
+    pin list: on a damaged list it reports damage, it does not crash or
+    loop for ever (an unchecked walk before)."""
+    name = f"{os.environ.get('HALSDK_INSTANCE', 't')}-markdead"[:40]
+    h = fuzz.Host(name, str(tmp_path))
+    h.tmp = tmp_path
+    env = dict(os.environ, HALSDK_INSTANCE=name)
+    victim = subprocess.Popen([sys.executable, "-c", VICTIM], cwd=tmp_path,
+                              env=env, stdout=subprocess.PIPE, text=True)
+    try:
+        assert victim.stdout is not None
+        assert victim.stdout.readline().strip() == "up"
+        rec = _record(h, K_PIN, "victim.out")
+        keep = _u32(h, rec)
+        _put(h, rec, rec)               # the pin list: a cycle
+        victim.kill()
+        victim.wait()
+        time.sleep(1.0)                 # the watch runs within 0.1 s
+        assert h.proc.poll() is None, h.host_log()
+        _put(h, rec, keep)
+        proc = _run(h, [HALCMD, "show", "comp", "victim"])
+        assert proc.returncode == 0, proc.stderr
+    finally:
+        if victim.poll() is None:
+            victim.kill()
+            victim.wait()
+        h.close()
+    assert fuzz.leftovers(name) == 0
 
 
 _inputs = st.lists(

@@ -452,14 +452,11 @@ int hal_comp_mark_dead(int id)
            when linked, their own value otherwise; one aligned 64-bit
            store each, which readers see whole */
         hoff_t co = SHMOFF(c);
-        hoff_t o = h->list_head[K_PIN];
-        while (o) {
-            hal_pin_t *p = SHMPTR(o);
+        /* the checked walk: the host must not crash on a damaged list */
+        FOR_EACH(K_PIN, hal_pin_t, p)
             if (p->comp == co && p->dir == HALSDK_OUT)
                 __atomic_store_n(&hal_pin_value(p)->lu, 0,
                                  __ATOMIC_RELEASE);
-            o = p->o.next;
-        }
         h->serial++;
     }
     hal_unlock();
