@@ -136,27 +136,43 @@ static int find_for_config(int kind_a, const char *a, void **found_a,
 /* ---------------------------------------------------------------- */
 /* process identity                                                 */
 
-uint64_t hal_proc_start_time(int pid)
+/* the fields of /proc/<pid>/stat after the command name (which may hold
+   spaces and parentheses): from the state letter on; NULL if unreadable */
+static const char *proc_stat_fields(int pid, char *buf, size_t size)
 {
-    char path[64], buf[1024];
+    char path[64];
     snprintf(path, sizeof(path), "/proc/%d/stat", pid);
-    int fd = open(path, O_RDONLY);
+    int fd = open(path, O_RDONLY | O_CLOEXEC);
     if (fd < 0)
-        return 0;
-    ssize_t n = read(fd, buf, sizeof(buf) - 1);
+        return NULL;
+    ssize_t n = read(fd, buf, size - 1);
     close(fd);
     if (n <= 0)
-        return 0;
+        return NULL;
     buf[n] = 0;
-    /* field 22 (starttime); the command name may hold spaces */
     char *p = strrchr(buf, ')');
+    return p && p[1] == ' ' ? p + 2 : NULL;
+}
+
+uint64_t hal_proc_start_time(int pid)
+{
+    char buf[1024];
+    const char *p = proc_stat_fields(pid, buf, sizeof(buf));
     if (!p)
         return 0;
-    int field = 2;
+    /* field 22 (starttime); p is at field 3 (state) */
+    int field = 3;
     for (; *p && field < 22; p++)
         if (*p == ' ')
             field++;
     return strtoull(p, NULL, 10);
+}
+
+char hal_proc_state(int pid)
+{
+    char buf[512];
+    const char *p = proc_stat_fields(pid, buf, sizeof(buf));
+    return p ? *p : 0;
 }
 
 int hal_pid_alive(int pid, uint64_t start)
@@ -169,19 +185,9 @@ int hal_pid_alive(int pid, uint64_t start)
     if (now == 0)
         return 0;
     /* a zombie still has /proc entries: treat it as gone */
-    char path[64], buf[512];
-    snprintf(path, sizeof(path), "/proc/%d/stat", pid);
-    int fd = open(path, O_RDONLY);
-    if (fd >= 0) {
-        ssize_t n = read(fd, buf, sizeof(buf) - 1);
-        close(fd);
-        if (n > 0) {
-            buf[n] = 0;
-            char *p = strrchr(buf, ')');
-            if (p && p[1] == ' ' && (p[2] == 'Z' || p[2] == 'X'))
-                return 0;
-        }
-    }
+    char st = hal_proc_state(pid);
+    if (st == 'Z' || st == 'X')
+        return 0;
     return start == 0 || now == start;
 }
 

@@ -420,6 +420,9 @@ int hal_instance_probe(const char *shm_name, int *host_pid,
                        uint64_t *host_start, int *abi);
 uint64_t hal_proc_start_time(int pid);
 int hal_pid_alive(int pid, uint64_t start);
+/* the state letter of process pid (man 5 proc: R, S, D, T, t, Z...),
+   0 when it cannot be read */
+char hal_proc_state(int pid);
 
 /* mutex: hal_lock() waits at most hal_lock_timeout() seconds (default
    HAL_LOCK_TIMEOUT, or $HALSDK_LOCK_TIMEOUT), then fails with ETIMEDOUT

@@ -97,30 +97,12 @@ static void say_host_ended(const char *what)
     }
 }
 
-/* the state letter of process pid (man 5 proc: R, S, D, T, t, Z...),
-   0 when it cannot be read */
-static char proc_state(int pid)
-{
-    char path[64], buf[512];
-    snprintf(path, sizeof(path), "/proc/%d/stat", pid);
-    int fd = open(path, O_RDONLY | O_CLOEXEC);
-    if (fd < 0)
-        return 0;
-    ssize_t n = read(fd, buf, sizeof(buf) - 1);
-    close(fd);
-    if (n <= 0)
-        return 0;
-    buf[n] = 0;
-    char *p = strrchr(buf, ')');        /* the command name may hold ) */
-    return p && p[1] == ' ' ? p[2] : 0;
-}
-
 /* the host is stopped (SIGSTOP, a debugger) for two looks in a row,
    STOP_LOOK_MS apart: a process group continued together (Ctrl-Z, fg)
    is never taken for stopped */
 static int host_stopped(int *looks)
 {
-    char st = proc_state(watch_pid);
+    char st = hal_proc_state(watch_pid);
     *looks = (st == 'T' || st == 't') ? *looks + 1 : 0;
     return *looks >= 2;
 }
