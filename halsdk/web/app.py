@@ -24,24 +24,33 @@ import contextlib
 import json
 import secrets
 from collections.abc import AsyncIterator, Awaitable
-from concurrent.futures import ThreadPoolExecutor
-from functools import partial
 from http.cookies import CookieError, SimpleCookie
 from importlib import resources
-from typing import Any, Callable, Optional, TypeVar
-from urllib.parse import parse_qsl, urlencode, urlsplit
+from typing import Any, Callable, Optional
+from urllib.parse import parse_qsl, urlencode
 
 from starlette.applications import Starlette
 from starlette.requests import Request
-from starlette.responses import FileResponse, JSONResponse, PlainTextResponse, Response
-from starlette.routing import Mount, Route, WebSocketRoute
+from starlette.responses import FileResponse, PlainTextResponse, Response
+from starlette.routing import BaseRoute, Mount, Route, WebSocketRoute
 from starlette.staticfiles import StaticFiles
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 from starlette.websockets import WebSocket, WebSocketDisconnect
 
 from halsdk.errors import HalError
 from halsdk.hal import Hal
-from halsdk.web.show import KINDS, Refused, Show
+from halsdk.web import latency, machine, scope
+from halsdk.web.common import (
+    HEADERS,
+    Workbench,
+    json_response,
+    read_body,
+    read_only_refusal,
+    refused,
+    same_origin,
+    word,
+)
+from halsdk.web.show import KINDS, Refused
 
 #: how often the websocket looks at the watched values (20 Hz: at least
 #: the 10 updates a second that the page promises)
@@ -53,18 +62,6 @@ MAX_WATCH = 5000
 
 FORBIDDEN = ("403 Forbidden: this workbench needs its token: open the "
              "URL that `halsdk web` printed\n")
-HEADERS = {
-    "Content-Security-Policy": (
-        "default-src 'self'; connect-src 'self'; img-src 'self' data:; "
-        "object-src 'none'; base-uri 'none'; frame-ancestors 'none'"),
-    "X-Content-Type-Options": "nosniff",
-    "Referrer-Policy": "no-referrer",
-    "Cache-Control": "no-store",
-}
-
-T = TypeVar("T")
-
-
 def static_folder() -> str:
     """The folder of the page's static files (package data)."""
     return str(resources.files("halsdk.web") / "static")
@@ -80,17 +77,6 @@ def cookie_name(scope: Scope) -> str:
 def _headers(scope: Scope) -> dict[str, str]:
     return {k.decode("latin-1").lower(): v.decode("latin-1")
             for k, v in scope.get("headers", [])}
-
-
-def same_origin(origin: Optional[str], host: Optional[str]) -> bool:
-    """True when an ``Origin`` header names the ``Host`` it was sent to."""
-    if not origin or not host:
-        return False
-    try:
-        parts = urlsplit(origin)
-    except ValueError:
-        return False
-    return parts.scheme in ("http", "https") and parts.netloc == host
 
 
 class TokenGate:
@@ -171,69 +157,17 @@ class TokenGate:
                                 headers=HEADERS)(scope, receive, send)
 
 
-class Workbench:
-    """The state of one workbench: the instance's :class:`Show` and the
-    one worker thread that every HAL call runs on, one at a time (so a
-    slow command never runs beside a value read of another page)."""
-
-    def __init__(self, hal: Hal, *, read_only: bool = False):
-        self.show = Show(hal, read_only=read_only)
-        self.read_only = read_only
-        self._pool = ThreadPoolExecutor(1, thread_name_prefix="halsdk-web")
-
-    async def call(self, fn: Callable[..., T], *args: Any) -> T:
-        loop = asyncio.get_running_loop()
-        return await loop.run_in_executor(self._pool, partial(fn, *args))
-
-    def close(self) -> None:
-        self._pool.shutdown(wait=True, cancel_futures=True)
-
-
-def _json(data: Any, status: int = 200) -> JSONResponse:
-    return JSONResponse(data, status_code=status, headers=HEADERS)
-
-
-def _refused(message: str) -> JSONResponse:
-    return _json({"ok": False, "output": "", "error": message + "\n"}, 403)
-
-
-async def _body(request: Request) -> dict[str, Any]:
-    """The JSON object of a change; ValueError for anything else."""
-    kind = request.headers.get("content-type", "").split(";")[0].strip()
-    if kind != "application/json":
-        raise ValueError("a change is a JSON request "
-                         "(Content-Type: application/json)")
-    origin = request.headers.get("origin")
-    if origin is not None and not same_origin(origin,
-                                              request.headers.get("host")):
-        raise PermissionError("the request's Origin is not this workbench")
-    try:
-        data = json.loads(await request.body())
-    except ValueError:
-        raise ValueError("the request's body is not JSON") from None
-    if not isinstance(data, dict):
-        raise ValueError("the request's body is not a JSON object")
-    return data
-
-
-def _word(data: dict[str, Any], key: str) -> str:
-    value = data.get(key)
-    if isinstance(value, bool) or not isinstance(value, (str, int, float)):
-        raise ValueError(f"'{key}' is missing or not a string")
-    return str(value)
-
-
 #: the changes of the page: the halcmd words of each from its JSON body
 ACTIONS: dict[str, Callable[[dict[str, Any]], list[str]]] = {
-    "setp": lambda d: ["setp", _word(d, "name"), _word(d, "value")],
-    "sets": lambda d: ["sets", _word(d, "name"), _word(d, "value")],
-    "unlinkp": lambda d: ["unlinkp", _word(d, "pin")],
-    "net": lambda d: ["net", _word(d, "signal"),
-                      *[_word({"pin": p}, "pin") for p in _list(d, "pins")]],
-    "addf": lambda d: ["addf", _word(d, "function"), _word(d, "thread"),
-                       *([_word(d, "position")]
+    "setp": lambda d: ["setp", word(d, "name"), word(d, "value")],
+    "sets": lambda d: ["sets", word(d, "name"), word(d, "value")],
+    "unlinkp": lambda d: ["unlinkp", word(d, "pin")],
+    "net": lambda d: ["net", word(d, "signal"),
+                      *[word({"pin": p}, "pin") for p in _list(d, "pins")]],
+    "addf": lambda d: ["addf", word(d, "function"), word(d, "thread"),
+                       *([word(d, "position")]
                          if d.get("position") not in (None, "") else [])],
-    "delf": lambda d: ["delf", _word(d, "function"), _word(d, "thread")],
+    "delf": lambda d: ["delf", word(d, "function"), word(d, "thread")],
 }
 
 
@@ -244,6 +178,11 @@ def _list(data: dict[str, Any], key: str) -> list[Any]:
     return value
 
 
+#: the pages: their path and their static HTML file
+PAGES = {"/": "index.html", "/scope": "scope.html",
+         "/machine": "machine.html", "/latency": "latency.html"}
+
+
 def create_app(hal: Hal, *, token: str, read_only: bool = False) -> Starlette:
     """The workbench of ``hal``, behind ``token``."""
     if not token:
@@ -251,36 +190,38 @@ def create_app(hal: Hal, *, token: str, read_only: bool = False) -> Starlette:
     bench = Workbench(hal, read_only=read_only)
     static = static_folder()
 
-    async def index(request: Request) -> Response:
-        return FileResponse(f"{static}/index.html", headers=HEADERS)
+    def page(filename: str) -> Callable[[Request], Awaitable[Response]]:
+        async def serve(request: Request) -> Response:
+            return FileResponse(f"{static}/{filename}", headers=HEADERS)
+        return serve
 
     async def info(request: Request) -> Response:
-        return _json(await bench.call(bench.show.info))
+        return json_response(await bench.call(bench.show.info))
 
     async def tree(request: Request) -> Response:
-        return _json(await bench.call(bench.show.tree))
+        return json_response(await bench.call(bench.show.tree))
 
     async def item(request: Request) -> Response:
         kind = request.query_params.get("kind", "")
         name = request.query_params.get("name", "")
         if kind not in KINDS.values():
-            return _json({"error": f"unknown kind {kind!r}"}, 400)
-        return _json(await bench.call(bench.show.detail, kind, name))
+            return json_response({"error": f"unknown kind {kind!r}"}, 400)
+        return json_response(await bench.call(bench.show.detail, kind, name))
 
     async def values(request: Request) -> Response:
         keys = request.query_params.getlist("key")[:MAX_WATCH]
-        return _json(await bench.call(bench.show.values, keys))
+        return json_response(await bench.call(bench.show.values, keys))
 
     async def change(request: Request) -> Response:
         action = request.path_params["action"]
         if action not in ACTIONS:
-            return _json({"error": f"unknown action {action!r}"}, 404)
-        if read_only:
-            return _refused(f"{action}: read-only: this workbench was "
-                            "started with --read-only and changes nothing")
+            return json_response({"error": f"unknown action {action!r}"}, 404)
+        refusal = read_only_refusal(bench, action)
+        if refusal is not None:
+            return refusal
 
         async def run() -> dict[str, Any]:
-            words = ACTIONS[action](await _body(request))
+            words = ACTIONS[action](await read_body(request))
             return await bench.call(bench.show.run_words, words)
         return await _answer(run)
 
@@ -288,7 +229,7 @@ def create_app(hal: Hal, *, token: str, read_only: bool = False) -> Starlette:
         """The command line; read-only still runs the commands that only
         read (show, getp, ...)."""
         async def run() -> dict[str, Any]:
-            line = (await _body(request)).get("line")
+            line = (await read_body(request)).get("line")
             if not isinstance(line, str):
                 raise ValueError("'line' is missing or not a string")
             return await bench.call(bench.show.command, line)
@@ -301,11 +242,11 @@ def create_app(hal: Hal, *, token: str, read_only: bool = False) -> Starlette:
         try:
             result = await run()
         except (PermissionError, Refused) as exc:
-            return _refused(str(exc))
+            return refused(str(exc))
         except ValueError as exc:
-            return _json({"ok": False, "output": "", "error": f"{exc}\n"},
+            return json_response({"ok": False, "output": "", "error": f"{exc}\n"},
                          400)
-        return _json(result, 200 if result["ok"] else 409)
+        return json_response(result, 200 if result["ok"] else 409)
 
     async def live(ws: WebSocket) -> None:
         await ws.accept()
@@ -358,8 +299,8 @@ def create_app(hal: Hal, *, token: str, read_only: bool = False) -> Starlette:
         yield
         bench.close()
 
-    routes = [
-        Route("/", index),
+    routes: list[BaseRoute] = [
+        *[Route(path, page(filename)) for path, filename in PAGES.items()],
         Route("/api/info", info),
         Route("/api/tree", tree),
         Route("/api/item", item),
@@ -367,6 +308,9 @@ def create_app(hal: Hal, *, token: str, read_only: bool = False) -> Starlette:
         Route("/api/command", command, methods=["POST"]),
         Route("/api/{action}", change, methods=["POST"]),
         WebSocketRoute("/ws", live),
+        *scope.routes(bench),
+        *machine.routes(bench),
+        *latency.routes(bench),
         Mount("/static", StaticFiles(directory=static), name="static"),
     ]
     app = Starlette(routes=routes, lifespan=lifespan)

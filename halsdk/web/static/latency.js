@@ -1,0 +1,2 @@
+// The Latency page of the HAL workbench.
+"use strict";

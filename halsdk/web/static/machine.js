@@ -1,0 +1,2 @@
+// The Machine page of the HAL workbench.
+"use strict";

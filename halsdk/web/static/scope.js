@@ -1,0 +1,2 @@
+// The Scope page of the HAL workbench.
+"use strict";
