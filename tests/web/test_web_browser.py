@@ -10,92 +10,16 @@ error.
 from __future__ import annotations
 
 import os
-import queue
 import shutil
-import subprocess
-import threading
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 import pytest
 from helpers.polling import wait_for
-from helpers.running_machine import halsdk_command
+from helpers.web import serve, stop
 
 from halsdk import halcmd
-
-TOKEN = "browser-test-token-42"
-
-
-def _chromium() -> str | None:
-    for name in ("chromium", "chromium-browser"):
-        found = shutil.which(name)
-        if found:
-            return found
-    return None
-
-
-def _unavailable(why: str) -> None:
-    if os.environ.get("CI") == "true":
-        pytest.fail(f"browser tests in CI: {why} (.ci/run installs "
-                    "Debian's chromium; playwright is a test extra)")
-    pytest.skip(why)
-
-
-@pytest.fixture(scope="module")
-def browser() -> Iterator[Any]:
-    exe = _chromium()
-    if exe is None:
-        _unavailable("no chromium (apt-get install chromium)")
-    try:
-        from playwright.sync_api import sync_playwright
-    except ImportError:
-        _unavailable("no playwright (pip install '.[test]')")
-    with sync_playwright() as p:
-        b = p.chromium.launch(executable_path=exe, headless=True)
-        try:
-            yield b
-        finally:
-            b.close()
-
-
-def _serve(cwd: Path, *args: str) -> tuple[subprocess.Popen, str]:
-    """``halsdk web`` on the test's instance; the process and its URL."""
-    proc = subprocess.Popen(
-        halsdk_command() + ["web", "--token", TOKEN, *args], cwd=cwd,
-        env=dict(os.environ), stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE, text=True)
-    lines: queue.Queue = queue.Queue()
-
-    def read() -> None:
-        assert proc.stdout is not None
-        for line in proc.stdout:
-            lines.put(line)
-        lines.put("")
-
-    threading.Thread(target=read, daemon=True).start()
-    while True:
-        try:
-            line = lines.get(timeout=60)
-        except queue.Empty:
-            line = ""
-        if "http://" in line:
-            return proc, line.strip()
-        if not line:
-            proc.kill()
-            proc.wait()
-            raise AssertionError(f"halsdk web did not start: "
-                                 f"{proc.stderr.read() if proc.stderr else ''}")
-
-
-def _stop(proc: subprocess.Popen) -> None:
-    proc.terminate()
-    try:
-        proc.communicate(timeout=30)
-    except subprocess.TimeoutExpired:
-        proc.kill()
-        proc.communicate()
-    assert proc.returncode == 0
 
 
 @pytest.fixture
@@ -109,11 +33,11 @@ def machine(hal):
 
 @pytest.fixture
 def workbench(machine, tmp_path) -> Iterator[str]:
-    proc, url = _serve(tmp_path)
+    proc, url = serve(tmp_path)
     try:
         yield url
     finally:
-        _stop(proc)
+        stop(proc)
 
 
 @pytest.fixture
@@ -217,7 +141,7 @@ def test_a_wrong_token_is_refused(browser, workbench):
 
 
 def test_read_only_refuses_a_setp(browser, machine, tmp_path):
-    proc, url = _serve(tmp_path, "--read-only")
+    proc, url = serve(tmp_path, "--read-only")
     try:
         context = browser.new_context()
         pg = context.new_page()
@@ -236,7 +160,7 @@ def test_read_only_refuses_a_setp(browser, machine, tmp_path):
         assert status[0] == 403 and "read-only" in status[1]
         context.close()
     finally:
-        _stop(proc)
+        stop(proc)
     assert machine.getp("and2.1.in1") is False
 
 
