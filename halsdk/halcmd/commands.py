@@ -445,22 +445,49 @@ class CommandRunner:
                                ) from None
         self.children.append(child)
         if wait_ready is not None:
-            name = wait_ready or os.path.basename(prog)
-            while True:
-                comp = self.hal.find("component", name)
-                if comp is not None and comp.ready:
-                    self.info(f"Component '{name}' ready")
-                    break
-                if child.poll() is not None:
-                    raise CommandError(f"{prog} exited without becoming "
-                                       "ready")
-                time.sleep(0.01)
+            self._wait_ready(wait_ready or os.path.basename(prog), prog,
+                             child)
         self.info(f"Program '{prog}' started")
         if wait_exit:
             code = child.wait()
             if code and not ignore:
                 raise CommandError(f"program '{prog}' failed, returned "
                                    f"{code if code > 0 else 128 - code}")
+
+    #: ``loadusr -W`` says what it waits for after this many seconds,
+    #: then adds a dot every WAIT_DOT_SECONDS, as the reference does
+    WAIT_SAY_SECONDS = 2.0
+    WAIT_DOT_SECONDS = 0.1
+
+    def _wait_ready(self, name: str, prog: str,
+                    child: subprocess.Popen) -> None:
+        """Wait until the component ``name`` is ready or ``child`` ends
+        (CommandError).  It waits as long as the program runs, as the
+        reference does, but not silently: after WAIT_SAY_SECONDS it says
+        which component it waits for (Ctrl-C ends the wait)."""
+        start = time.monotonic()
+        next_say = start + self.WAIT_SAY_SECONDS
+        said = False
+        try:
+            while True:
+                comp = self.hal.find("component", name)
+                if comp is not None and comp.ready:
+                    break
+                if child.poll() is not None:
+                    raise CommandError(f"{prog} exited without becoming "
+                                       "ready")
+                now = time.monotonic()
+                if now >= next_say:
+                    self.err("." if said else
+                             f"Waiting for component '{name}' to become "
+                             "ready")
+                    said = True
+                    next_say = now + self.WAIT_DOT_SECONDS
+                time.sleep(0.01)
+        finally:
+            if said:
+                self.err("\n")
+        self.info(f"Component '{name}' ready")
 
     def cmd_waitusr(self, args: list[str]) -> None:
         name = args[0]

@@ -280,6 +280,21 @@ def test_loadusr_waits_for_ready_and_unloadusr(tmp_path):
     assert _shm_left(env) == []
 
 
+def test_loadusr_says_what_it_waits_for(tmp_path):
+    """A -W wait for a component that never comes is not silent: after
+    2 s it names the component and adds dots, as the reference does."""
+    (tmp_path / "w.hal").write_text("loadusr -W sleep 3\n")
+    env = _env(tmp_path, "wait")
+    proc = _cli(["halrun", "-f", "w.hal"], tmp_path, env)
+    first, second = proc.stdout.splitlines()[:2]
+    assert first.startswith("Waiting for component 'sleep' to become "
+                            "ready.")
+    assert set(first.rpartition("ready")[2]) == {"."}
+    assert second == "w.hal:1: sleep exited without becoming ready"
+    assert proc.returncode == 1
+    assert _shm_left(env) == []
+
+
 def test_save_to_file_matches_stdout_and_reloads(hal, tmp_path):
     hal.loadrt("and2", count=2)
     cap = _Capture()
