@@ -43,7 +43,7 @@ from halsdk.web.common import (
 #: most channels of one scope
 MAX_CHANNELS = 16
 #: how often the stream is drained (seconds)
-POLL = 0.03
+POLL = 0.05
 #: how often the status goes to the page without a screen (seconds)
 STATUS_PERIOD = 0.25
 #: how often the channels are checked to still exist (seconds)
