@@ -28,7 +28,18 @@ Value = Union[bool, int, float, str]
 # requests an attached process forwards to the host
 _HOST_OPS = ("loadrt", "unloadrt", "unload", "newinst", "delinst",
              "newthread", "delthread", "addf", "delf", "start", "stop",
-             "step", "loadrt_args")
+             "step", "loadrt_args", "recorder", "recorder_delete")
+
+
+def _pid_alive(pid: int) -> bool:
+    """Whether process ``pid`` runs (a zombie has ended)."""
+    try:
+        with open(f"/proc/{pid}/stat", "rb") as f:
+            stat = f.read()
+    except OSError:
+        return False
+    state = stat[stat.rfind(b")") + 2:][:1]
+    return state not in (b"Z", b"X", b"")
 
 
 def is_halcmd_comp(name: str, pid: int) -> bool:
@@ -800,6 +811,102 @@ class Hal:
             _core.comp_exit(cid)
 
     _captures = 0
+
+    # ------------------------------------------------------------ recorders
+
+    #: the prefix of a recorder's component, function and stream
+    RECORDER_PREFIX = "__recorder"
+    #: most records a recorder's stream holds
+    RECORDER_MAX_DEPTH = 1 << 20
+
+    def recorder(self, names: Union[str, Iterable[str]], thread: str,
+                 depth: int) -> str:
+        """Start recording pins, signals or params once per cycle of
+        ``thread`` into a stream, until :meth:`recorder_delete`.
+
+        The continuous form of :meth:`capture`, for an attached process
+        too (the host runs it): a realtime function, added last to
+        ``thread``, copies the current value of each name (a pin's value
+        is looked up on every cycle, so linking it later is seen) into a
+        stream of ``depth`` records that the caller drains with
+        ``Hal.stream(name).read_many()``; records that find it full are
+        dropped and counted (``overruns``, a gap in ``sampleno``).
+        Returns the recorder's name (of its component, function and
+        stream).  The recorder belongs to the calling process: the host
+        removes the recorders of processes that have ended whenever a
+        recorder is made or deleted.
+        """
+        if isinstance(names, str):
+            names = [names]
+        return self._call_host("recorder", list(names), thread, depth,
+                               os.getpid())
+
+    def _host_recorder(self, names: list, thread: str, depth: int,
+                       pid: int) -> str:
+        if not isinstance(names, list) or not all(
+                isinstance(n, str) for n in names):
+            raise InvalidError("recorder: names must be a list of strings")
+        if not 1 <= len(names) <= 256:
+            raise InvalidError(f"recorder of {len(names)} values: 1 to 256 "
+                               "allowed")
+        if isinstance(depth, bool) or not isinstance(depth, int) or \
+                not 2 <= depth <= Hal.RECORDER_MAX_DEPTH:
+            raise InvalidError(f"recorder: depth={depth!r}: 2 to "
+                               f"{Hal.RECORDER_MAX_DEPTH} records allowed")
+        if isinstance(pid, bool) or not isinstance(pid, int) or pid <= 0:
+            raise InvalidError(f"recorder: bad pid {pid!r}")
+        with self._conn.lock:
+            self._sweep_recorders()
+            items = []
+            for name in names:
+                obj = (_core.find("pin", name) or _core.find("signal", name)
+                       or _core.find("param", name))
+                if obj is None:
+                    raise NotFoundError(f"recorder: no pin, signal or param "
+                                        f"named '{name}'")
+                items.append(obj)
+            th = self.thread(thread)
+            Hal._captures += 1
+            comp = f"{Hal.RECORDER_PREFIX}{pid}.{Hal._captures}"
+            _core.set_loading_rt(True)
+            try:
+                cid = _core.comp_new(comp, _core.COMP_RT)
+            finally:
+                _core.set_loading_rt(False)
+            try:
+                uses_fp = any(o.type == _core.FLOAT for o in items)
+                _core.capture_new(cid, comp, comp, items, depth - 1, uses_fp)
+                _core.comp_ready(cid, True)
+                _core.addf(comp, th.name, -1)
+            except BaseException:
+                _core.comp_exit(cid)
+                raise
+            return comp
+
+    def recorder_delete(self, name: str) -> None:
+        """Remove a recorder made by :meth:`recorder` (its function leaves
+        the thread, its stream goes)."""
+        self._call_host("recorder_delete", name)
+
+    def _host_recorder_delete(self, name: str) -> None:
+        if not isinstance(name, str) or \
+                not name.startswith(Hal.RECORDER_PREFIX):
+            raise InvalidError(f"'{name}' is not a recorder")
+        with self._conn.lock:
+            comp = _core.find("component", name)
+            if comp is None:
+                raise NotFoundError(f"recorder '{name}' not found")
+            _core.comp_exit(comp.id)
+            self._sweep_recorders()
+
+    def _sweep_recorders(self) -> None:
+        """Remove the recorders whose process has ended."""
+        for comp in _core.items("component"):
+            if not comp.name.startswith(Hal.RECORDER_PREFIX):
+                continue
+            pid = comp.name[len(Hal.RECORDER_PREFIX):].split(".")[0]
+            if pid.isdigit() and not _pid_alive(int(pid)):
+                _core.comp_exit(comp.id)
 
     # ------------------------------------------------------------ halcmd
 
