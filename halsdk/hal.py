@@ -31,17 +31,6 @@ _HOST_OPS = ("loadrt", "unloadrt", "unload", "newinst", "delinst",
              "step", "loadrt_args", "recorder", "recorder_delete")
 
 
-def _pid_alive(pid: int) -> bool:
-    """Whether process ``pid`` runs (a zombie has ended)."""
-    try:
-        with open(f"/proc/{pid}/stat", "rb") as f:
-            stat = f.read()
-    except OSError:
-        return False
-    state = stat[stat.rfind(b")") + 2:][:1]
-    return state not in (b"Z", b"X", b"")
-
-
 def is_halcmd_comp(name: str, pid: int) -> bool:
     """Whether a component is the ``halcmd<pid>`` of a halcmd session
     (``unload all`` and ``unloadusr all`` leave those alone)."""
@@ -905,7 +894,7 @@ class Hal:
             if not comp.name.startswith(Hal.RECORDER_PREFIX):
                 continue
             pid = comp.name[len(Hal.RECORDER_PREFIX):].split(".")[0]
-            if pid.isdigit() and not _pid_alive(int(pid)):
+            if pid.isdigit() and not _core.pid_alive(int(pid)):
                 _core.comp_exit(comp.id)
 
     # ------------------------------------------------------------ halcmd
