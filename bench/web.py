@@ -19,7 +19,11 @@ server CPU         user + system time of the ``halsdk web`` process over
                    the measured time, in % of one core (/proc/PID/stat)
 =================  ======================================================
 
-Run: ``python bench/web.py [--seconds 60] [--channels 8]``.
+It then runs the Show page's measurement (bench/web_show.py: 10,000
+pins, the page in headless chromium); ``--pages scope`` or ``--pages
+show`` runs one of them.
+
+Run: ``python bench/web.py [--seconds 60] [--channels 8] [--pages ...]``.
 """
 
 from __future__ import annotations
@@ -37,6 +41,8 @@ import urllib.request
 from websockets.sync.client import connect
 
 import halsdk
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 TOKEN = "bench-web-token-0123456789"
 PINS = ["siggen.0.sine", "siggen.0.cosine", "siggen.0.square",
@@ -149,7 +155,16 @@ def main() -> int:
     p.add_argument("--channels", type=int, default=8,
                    choices=range(1, len(PINS) + 1), metavar="N",
                    help="channels (default 8)")
+    p.add_argument("--pages", default="scope,show",
+                   help="the pages measured, comma separated (default "
+                        "scope,show)")
     args = p.parse_args()
+    pages = set(args.pages.split(","))
+    if "show" in pages:
+        import web_show
+        web_show.main([])
+    if "scope" not in pages:
+        return 0
     r = run(args.seconds, args.channels)
     print("Scope page: channels at 1 kHz, roll mode, one websocket client")
     print(f"{'channels':>8} {'seconds':>8} {'samples':>9} {'rate/s':>8} "
