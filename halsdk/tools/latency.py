@@ -267,6 +267,11 @@ class LatencyTest:
             if self.started:
                 raise LatencyError("latency test: already running")
             self._check_free()
+            if run and self.hal.lock_level & Hal.LOCK_RUN:
+                # a thread made while HAL runs starts at once: the lock
+                # against starting threads must refuse it here
+                raise LatencyError("latency test: cannot start: HAL is "
+                                   "locked against starting threads")
             running = bool(self.hal.info()["threads_running"])
             others = [t.name for t in self.hal.threads()]
             if run and not running and others:

@@ -17,9 +17,10 @@ from helpers.web import serve, stop
 
 
 def names(hal) -> dict[str, list[str]]:
-    return {"components": sorted(c.name for c in hal.components()),
-            "threads": sorted(t.name for t in hal.threads()),
-            "functions": sorted(f.name for f in hal.functions())}
+    # records taken under the instance lock: a test being removed
+    # meanwhile (by the server) does not make a listing fail
+    return {kind + "s": sorted(r.name for r in hal.snapshot(kind))
+            for kind in ("component", "thread", "function")}
 
 
 @pytest.fixture
