@@ -259,10 +259,15 @@ class LatencyTest:
 
     # ---------------------------------------------------------- lifetime
 
-    def start(self, run: bool = True) -> None:
+    def start(self, run: bool = True, realtime: bool = True) -> None:
         """Add the threads and components and start them (``run``
         False: leave a stopped instance stopped, for stepping).  On any
-        refusal, what was added is removed and LatencyError says why."""
+        refusal, what was added is removed and LatencyError says why.
+
+        ``realtime``: ask for realtime scheduling when the test starts
+        the instance (:meth:`halsdk.Hal.start`); threads made in an
+        instance that runs already are scheduled as its threads are.
+        :attr:`realtime` and :attr:`note` say what the threads got."""
         with self._lock:
             if self.started:
                 raise LatencyError("latency test: already running")
@@ -284,9 +289,9 @@ class LatencyTest:
             try:
                 self._build()
                 if run and not running:
-                    note = self.hal.start()
+                    note = self.hal.start(realtime)
                     self._started_instance = True
-                    self.realtime = note is None
+                    self.realtime = realtime and note is None
                     self.note = note or ""
                 elif run:
                     self.realtime = host_realtime(
@@ -296,7 +301,10 @@ class LatencyTest:
                     self.note = "realtime scheduling (SCHED_FIFO)"
                 elif self.realtime is False and not self.note:
                     self.note = ("Note: Using POSIX non-realtime (the "
-                                 "instance's threads run without SCHED_FIFO)")
+                                 "threads run without SCHED_FIFO)")
+                elif run and self.realtime is None:
+                    self.note = ("the threads' scheduling is not known "
+                                 "(the host's /proc cannot be read)")
                 if run:
                     self.reset()
             except (HalError, LatencyError) as exc:

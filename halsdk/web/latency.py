@@ -13,8 +13,10 @@ API (changes are JSON POSTs, refused under ``--read-only``):
 - ``GET /api/latency/state``: running, the scheduling, every thread's
   figures and histogram, the defaults and limits of the settings;
 - ``POST /api/latency/start`` ``{"base": ns, "servo": ns, "base_binsize":
-  ns, "servo_binsize": ns, "bins": n}`` (``base`` 0: the servo thread
-  only); ``POST /api/latency/reset``; ``POST /api/latency/stop``;
+  ns, "servo_binsize": ns, "bins": n, "realtime": true}`` (``base`` 0:
+  the servo thread only; ``realtime`` false: no realtime scheduling,
+  when the test starts the instance); ``POST /api/latency/reset``;
+  ``POST /api/latency/stop``;
 - ``/ws/latency``: the state, pushed at :data:`PUSH_PERIOD`.
 
 What the test added is removed by stop, when the server ends, and when
@@ -62,8 +64,12 @@ SETTINGS: dict[str, tuple[int, int, int]] = {
 
 def parse_settings(data: dict[str, Any]) -> dict[str, int]:
     """The settings of a start from its JSON body (missing: the
-    default); ValueError naming a bad one."""
-    out = {}
+    default; ``realtime``, true by default, as 1 or 0); ValueError
+    naming a bad one."""
+    realtime = data.get("realtime", True)
+    if not isinstance(realtime, bool):
+        raise ValueError("'realtime' is not true or false")
+    out = {"realtime": int(realtime)}
     for key, (default, least, most) in SETTINGS.items():
         value = data.get(key, default)
         if isinstance(value, str) and value.strip().lstrip("-").isdigit():
@@ -102,7 +108,7 @@ class LatencyPage:
             base_binsize=settings["base_binsize"],
             servo_binsize=settings["servo_binsize"], bins=settings["bins"])
         test = LatencyTest(self.bench.hal, threads)
-        test.start()
+        test.start(realtime=bool(settings["realtime"]))
         self.test, self.settings = test, settings
         self.monitor = LatencyMonitor(test)
         self.monitor.start()

@@ -112,6 +112,21 @@ def test_the_push_is_at_least_twice_a_second():
     assert page.PUSH_PERIOD <= 0.5
 
 
+def test_a_start_without_realtime_scheduling(hal):
+    """The test starts a stopped instance: without realtime scheduling
+    when asked, and the state says so."""
+    with _client(hal) as c:
+        c.get("/?token=" + TOKEN)
+        r = post(c, "start", realtime=False, **QUICK)
+        assert r.status_code == 200, r.text
+        state = r.json()["state"]
+        assert state["realtime"] is False
+        assert "non-realtime" in state["note"]
+        assert post(c, "stop").status_code == 200
+    assert not hal.info()["threads_running"]
+    assert names(hal)["threads"] == []
+
+
 def test_a_second_start_is_refused(client, hal):
     assert post(client, "start", **QUICK).status_code == 200
     r = post(client, "start", **QUICK)
@@ -125,6 +140,7 @@ def test_a_second_start_is_refused(client, hal):
     ({"bins": 5000}, "'bins' 5000 is not from 1 to 1000"),
     ({"servo_binsize": 0}, "'servo_binsize' 0"),
     ({"servo": True}, "'servo' is not an integer"),
+    ({"realtime": "yes"}, "'realtime' is not true or false"),
 ])
 def test_bad_settings_are_refused(client, hal, body, word):
     before = names(hal)

@@ -198,6 +198,41 @@ def test_the_monitor_reads_histograms(hal):
     assert t["histogram"]["total"] == t["samples"] > 0
 
 
+# ---------------------------------------------------------------- scheduling
+
+def test_without_realtime_scheduling_it_says_so(hal):
+    test = LatencyTest(hal, setups(0, 1_000_000, bins=10))
+    test.start(realtime=False)
+    try:
+        assert test.realtime is False
+        assert "non-realtime" in test.note
+        # no thread of the host got SCHED_FIFO
+        assert latency.host_realtime(os.getpid()) is False
+        time.sleep(0.2)
+        t = test.figures(read=True)["threads"][0]
+        assert t["samples"] == t["histogram"]["total"] > 0
+    finally:
+        test.stop()
+
+
+@pytest.mark.parametrize("realtime", [False, True])
+def test_in_a_running_instance_it_reads_the_hosts_scheduling(hal,
+                                                             realtime):
+    """The threads start as the instance's did: realtime when the host
+    got it (its start returned no note)."""
+    hal.newthread("servo", 1_000_000)
+    note = hal.start(realtime)
+    got = realtime and note is None
+    test = LatencyTest(hal, setups(0, 1_000_000, bins=10))
+    test.start()
+    try:
+        assert test.realtime is got
+        assert "SCHED_FIFO" in test.note
+        assert ("non-realtime" in test.note) == (not got)
+    finally:
+        test.stop()
+
+
 # ---------------------------------------------------------------- refusals
 
 def test_a_stopped_instance_with_threads_is_refused(hal):

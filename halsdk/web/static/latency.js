@@ -176,7 +176,8 @@ function settings() {
   const v = (name) => Number(form.elements[name].value);
   return {base: Math.round(v("base") * 1000), servo: Math.round(v("servo") * 1000),
           base_binsize: Math.round(v("base_binsize")),
-          servo_binsize: Math.round(v("servo_binsize")), bins: Math.round(v("bins"))};
+          servo_binsize: Math.round(v("servo_binsize")), bins: Math.round(v("bins")),
+          realtime: form.elements.realtime.checked};
 }
 
 function connect() {
