@@ -106,6 +106,7 @@ def test_a_latency_test_runs_live_and_leaves_nothing(browser, workbench,
     assert machine.info()["threads_running"]    # the user's thread runs
 
 
+@pytest.mark.slow                           # the server waits 5 s for a reload
 def test_the_test_ends_when_the_page_goes(browser, workbench, machine):
     before = names(machine)
     context, pg, errors = _open(browser, workbench)
