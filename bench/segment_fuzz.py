@@ -296,9 +296,20 @@ class Host:
         with open(self.log, errors="replace") as f:
             return f.read()[-3000:]
 
-    def restore(self) -> None:
-        """Put the bytes back (header, index and every record)."""
-        self.mm[:len(self.keep)] = self.keep
+    def restore(self, writes: Sequence[tuple[int, bytes]] = ()) -> None:
+        """Put the bytes back (header, index and every record).  The
+        instance mutex is left as it is while a process holds it, unless
+        ``writes`` (this input's) went into it: putting its free state
+        back under a holder would be this script's own damage."""
+        moff, msize = self.layout.fields["mutex"]
+        ours = any(moff - 8 < off < moff + msize for off, _ in writes)
+        held = struct.unpack_from("<I", self.mm, moff)[0] != 0
+        if held and not ours:
+            self.mm[:moff] = self.keep[:moff]
+            self.mm[moff + msize:len(self.keep)] = \
+                self.keep[moff + msize:]
+        else:
+            self.mm[:len(self.keep)] = self.keep
 
     def close(self) -> None:
         if getattr(self, "_mapped", False):
@@ -443,7 +454,7 @@ def run_forked(host: Host, inp: Input, cmd_file: str, timeout: float,
                 counts.errors += 1
                 if counts.errors <= 3:
                     counts.notes.append(f"error: {inp}\n{text[-600:]}")
-    host.restore()
+    host.restore(writes)
 
 
 def worker(count: int, seed: int, timeout: float, include_mutex: bool,

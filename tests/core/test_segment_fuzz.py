@@ -302,3 +302,77 @@ def test_campaign_script_counts_no_failure(tmp_path: Path) -> None:
     assert proc.returncode == 0, proc.stdout + proc.stderr
     assert "crashes 0, tracebacks 0, hangs 0, leftovers 0" in proc.stdout
     assert "60 inputs" in proc.stdout
+
+
+HOLDER = """\
+import sys
+from halsdk import Hal
+from halsdk.core import _core
+hal = Hal(create=True)
+print("up", flush=True)
+from halsdk.errors import HalError
+sys.stdin.readline()
+try:
+    _core.hold_lock_for_test(1.5)
+    print("unlocked", flush=True)
+except HalError as exc:
+    print(f"unlocked: {exc}", flush=True)
+hal.newsig("after", "float")
+print(len(hal.signals()), flush=True)
+sys.stdin.readline()
+hal.close()
+"""
+
+
+def test_the_lock_holder_survives_a_write_into_the_held_mutex(
+        tmp_path: Path) -> None:
+    """glibc keeps a held robust mutex in the holder's robust list, with
+    pointers inside the mutex; unlocking follows them.  Another process
+    writing there while the host held the lock made the host die of
+    SIGSEGV in pthread_mutex_unlock (found by the campaign): the holder
+    puts back what is its own before unlocking."""
+    import mmap
+
+    from halsdk.core import _core
+    from halsdk.core.instance import shm_name
+    name = f"{os.environ.get('HALSDK_INSTANCE', 't')}-heldmutex"[:40]
+    env = dict(os.environ, HALSDK_INSTANCE=name)
+    holder = subprocess.Popen([sys.executable, "-c", HOLDER], cwd=tmp_path,
+                              env=env, stdin=subprocess.PIPE,
+                              stdout=subprocess.PIPE, text=True)
+    assert holder.stdout is not None and holder.stdin is not None
+    try:
+        assert holder.stdout.readline().strip() == "up"
+        fd = os.open("/dev/shm" + shm_name(name), os.O_RDWR)
+        try:
+            mm = mmap.mmap(fd, 0)
+        finally:
+            os.close(fd)
+        moff, _size = _core.segment_layout()["mutex"]
+        holder.stdin.write("\n")
+        holder.stdin.flush()
+        deadline = time.monotonic() + 10
+        while struct.unpack_from("<I", mm, moff)[0] == 0:   # __lock
+            assert time.monotonic() < deadline, "the lock was not taken"
+            time.sleep(0.001)
+        # __owner, then __list.__prev and __list.__next: small numbers
+        struct.pack_into("<i", mm, moff + 8, 4242)
+        struct.pack_into("<QQ", mm, moff + 24, 0x10, 0x18)
+        said = holder.stdout.readline().strip()
+        assert said.startswith("unlocked: instance ") and said.endswith(
+            "is damaged: the instance mutex was written over while pid "
+            f"{holder.pid} held it (repaired)"), said
+        assert int(holder.stdout.readline()) == 1   # the lock works on
+        proc = subprocess.run([HALCMD, "show", "comp"], cwd=tmp_path,
+                              env=env, capture_output=True, text=True,
+                              timeout=TIMEOUT)
+        assert proc.returncode == 0, proc.stderr
+        mm.close()
+        holder.stdin.write("\n")
+        holder.stdin.flush()
+        assert holder.wait(TIMEOUT) == 0
+    finally:
+        if holder.poll() is None:
+            holder.kill()
+            holder.wait()
+    assert fuzz.leftovers(name) == 0

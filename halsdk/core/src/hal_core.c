@@ -290,7 +290,7 @@ static void instance_mutexattr(pthread_mutexattr_t *ma)
 /* whether the mutex in the segment is still of the kind it was made:
    a stray write into its kind word makes glibc take it for another kind
    of mutex and abort the process inside pthread_mutex_lock */
-static int mutex_kind_ok(const pthread_mutex_t *m)
+static int mutex_kind_wanted(void)
 {
     static int want = -1;
     if (want == -1) {
@@ -302,7 +302,54 @@ static int mutex_kind_ok(const pthread_mutex_t *m)
         want = fresh.__data.__kind;
         pthread_mutex_destroy(&fresh);
     }
-    return __atomic_load_n(&m->__data.__kind, __ATOMIC_RELAXED) == want;
+    return want;
+}
+
+static int mutex_kind_ok(const pthread_mutex_t *m)
+{
+    return __atomic_load_n(&m->__data.__kind, __ATOMIC_RELAXED) ==
+           mutex_kind_wanted();
+}
+
+/* What glibc wrote into the instance mutex when this thread took it: its
+   owner and its place in the thread's robust list (two pointers into
+   this process).  pthread_mutex_unlock follows those pointers, so a
+   stray write there by another process while this thread holds the
+   mutex would crash this one; the holder puts back what is its own
+   first.  The lock word itself is never put back: waiters set bits in
+   it. */
+static __thread struct {
+    int held;
+    int owner;
+    __pthread_list_t list;
+} mine;
+
+static void mutex_remember(const pthread_mutex_t *m)
+{
+    mine.held = 1;
+    mine.owner = m->__data.__owner;
+    mine.list = m->__data.__list;
+}
+
+/* put back what this thread wrote into the mutex it holds; 1 when
+   something had been changed */
+static int mutex_repair(pthread_mutex_t *m)
+{
+    int changed = 0;
+    if (!mutex_kind_ok(m)) {
+        m->__data.__kind = mutex_kind_wanted();
+        changed = 1;
+    }
+    if (m->__data.__owner != mine.owner) {
+        m->__data.__owner = mine.owner;
+        changed = 1;
+    }
+    if (memcmp(&m->__data.__list, &mine.list, sizeof(mine.list)) != 0) {
+        m->__data.__list = mine.list;
+        changed = 1;
+    }
+    __atomic_thread_fence(__ATOMIC_SEQ_CST);
+    return changed;
 }
 
 int hal_lock(void)
@@ -345,6 +392,7 @@ int hal_lock(void)
     if (r)
         return hal_fail(r, "cannot lock HAL instance '%s': %s", h->instance,
                         strerror(r));
+    mutex_remember(&h->mutex);
     __atomic_store_n(&h->lock_holder, (int32_t)getpid(), __ATOMIC_RELAXED);
     return 0;
 }
@@ -352,11 +400,19 @@ int hal_lock(void)
 void hal_unlock(void)
 {
     if (hal_map.hdr) {
+        pthread_mutex_t *m = &hal_map.hdr->mutex;
         __atomic_store_n(&hal_map.hdr->lock_holder, 0, __ATOMIC_RELAXED);
-        /* damaged while held: glibc would abort; the next hal_lock of
-           any process reports the damage */
-        if (mutex_kind_ok(&hal_map.hdr->mutex))
-            pthread_mutex_unlock(&hal_map.hdr->mutex);
+        if (mine.held) {
+            mine.held = 0;
+            /* written over while held: glibc would abort or follow a
+               wild pointer; what was ours goes back, and it is said */
+            if (mutex_repair(m))
+                hal_damaged("the instance mutex was written over while "
+                            "pid %d held it (repaired)", (int)getpid());
+            pthread_mutex_unlock(m);
+        } else if (mutex_kind_ok(m)) {
+            pthread_mutex_unlock(m);
+        }
     }
 }
 
