@@ -1,5 +1,6 @@
 """``halsdk web machine.ini``: the machine and the workbench started
-together (halsdk.web.machinehost), ended together.
+together (halsdk.web.machinehost), ended together; and the Machine page
+of a workbench whose instance runs no task controller.
 """
 
 from __future__ import annotations
@@ -12,10 +13,13 @@ from pathlib import Path
 import pytest
 from helpers.polling import wait_for
 from helpers.running_machine import halsdk_command, mill_ini
+from starlette.testclient import TestClient
 
 from halsdk.testing import private_instance_name
+from halsdk.web.app import create_app
 
 TOKEN = "serve-token-0123456789"
+BASE = "http://127.0.0.1:8125"
 
 
 def segments(instance: str) -> list[str]:
@@ -140,3 +144,22 @@ def test_help_names_the_ini_file():
     out = subprocess.run(halsdk_command() + ["web", "--help"],
                          capture_output=True, text=True, timeout=60).stdout
     assert "machine.ini" in out and "halsdk run" in out
+
+
+def test_no_task_controller(hal):
+    """HAL runs, but no task: the page says so and keeps looking."""
+    app = create_app(hal, token=TOKEN)
+    with TestClient(app, base_url=BASE) as c:
+        c.get("/?token=" + TOKEN)
+
+        def why() -> str:
+            return c.get("/api/machine/status").json().get("why", "")
+        assert wait_for(lambda: "no task" in why(), 10)
+        assert c.get("/api/machine/status").json()["connected"] is False
+        r = c.post("/api/machine/on", json={}, headers={"origin": BASE})
+        assert r.status_code == 503 and "no task" in r.json()["error"]
+        page = app.state.workbench.pages["machine"]
+        tries = page._next_try
+        # it keeps looking, once a second
+        assert wait_for(lambda: (c.get("/api/machine/status"),
+                                 page._next_try > tries)[1], 10)
