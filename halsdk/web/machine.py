@@ -298,6 +298,9 @@ class MachinePage:
         self._next_try = 0.0
         self._lock = threading.Lock()
         self._closed = False
+        #: the axes of continuous jogs started and not stopped: stopped
+        #: when a page goes away (never left jogging)
+        self.jogging: set[str] = set()
 
     # -- connection ------------------------------------------------------
 
@@ -332,10 +335,29 @@ class MachinePage:
             with contextlib.suppress(Exception):
                 self._background.submit(client.close)
 
+    def _stop_jogs(self, client: MachineClient) -> None:
+        for axis in sorted(self.jogging):
+            with contextlib.suppress(Exception):
+                _jog_stop(client, {"axis": axis})
+            self.jogging.discard(axis)
+
+    def stop_jogs(self) -> None:
+        """Stop the continuous jogs the pages started (a page that went
+        away cannot stop its own); on the page's thread, not waited
+        for (a cancelled websocket handler cannot wait)."""
+        client = self.client
+        if client is None or not self.jogging or self._closed:
+            return
+        with contextlib.suppress(RuntimeError):     # shut down already
+            self._commands.submit(self._stop_jogs, client)
+
     def close(self) -> None:
         with self._lock:
             self._closed = True
             client, self.client = self.client, None
+        if client is not None and self.jogging:
+            with contextlib.suppress(Exception):
+                self._commands.submit(self._stop_jogs, client).result(10)
         self._commands.shutdown(wait=True, cancel_futures=True)
         self._background.shutdown(wait=True, cancel_futures=True)
         if client is not None:
@@ -418,6 +440,10 @@ class MachinePage:
             return 400, {"ok": False, "error": _reason(exc)}
         except HalError as exc:
             return 409, {"ok": False, "error": str(exc)}
+        if action == "jog" and data.get("distance") is None:
+            self.jogging.add(str(data["axis"]).upper())
+        elif action == "jog-stop":
+            self.jogging.discard(str(data["axis"]).upper())
         return 200, {"ok": True,
                      **(result if isinstance(result, dict) else {})}
 
@@ -640,6 +666,7 @@ def routes(bench: Workbench) -> list[BaseRoute]:
             task.cancel()
             with contextlib.suppress(BaseException):
                 await task
+            page.stop_jogs()
 
     return [
         Route("/api/machine/status", status),

@@ -149,6 +149,25 @@ def test_jog_by_an_increment(client):
 
 
 @pytest.mark.slow
+def test_a_page_going_away_stops_its_continuous_jog(client):
+    ready(client)
+    assert wait_for(lambda: idle(client), 30)
+    # far from the limits: X -1 to 201 (examples/mill/mill.ini)
+    assert post(client, "mdi", line="G53 G0 X100").status_code == 200
+    assert wait_for(lambda: status(client)["machine"][0] == 100, 30)
+    assert wait_for(lambda: idle(client), 30)
+    with client.websocket_connect(WS, headers=ORIGIN) as ws:
+        ws.receive_json()
+        r = post(client, "jog", axis="X", velocity=-2)
+        assert r.status_code == 200, r.text
+        assert wait_for(lambda: status(client)["velocity"] > 0, 10)
+    # the page closed without its jog-stop: the workbench stops the jog
+    assert wait_for(lambda: idle(client), 10)
+    assert client.app.state.workbench.pages["machine"].jogging == set()
+    assert status(client)["machine"][0] > 80    # stopped, not at a limit
+
+
+@pytest.mark.slow
 def test_bad_requests(client):
     connected(client)
     assert post(client, "mdi").status_code == 400
