@@ -122,6 +122,27 @@ def test_home_mdi_program_and_backplot(browser, mill, tmp_path):
     assert errors == []
 
 
+def test_without_a_task_controller_the_page_says_so(browser, hal,
+                                                    tmp_path):
+    hal.newthread("servo", 1_000_000)
+    proc, url = serve(tmp_path)             # attached to the test's HAL
+    try:
+        context = browser.new_context()
+        page = context.new_page()
+        page.goto(url)
+        page.goto(url.split("/?")[0] + "/machine")
+        page.locator("#link", has_text="live").wait_for(timeout=20_000)
+        banner = page.locator("#nomachine")
+        banner.wait_for(timeout=20_000)
+        assert "No task controller" in banner.inner_text()
+        page.locator("#nomachine-why", has_text="no task").wait_for()
+        assert "off" in (page.locator("#panel").get_attribute("class")
+                         or "")
+        context.close()
+    finally:
+        stop(proc)
+
+
 def test_read_only_refuses_a_command(browser, tmp_path):
     instance = private_instance_name()
     proc, url = serve(tmp_path, str(mill_ini(tmp_path)), "--instance",
