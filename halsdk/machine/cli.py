@@ -1,7 +1,8 @@
 """The ``halsdk`` command: ``halsdk run machine.ini`` starts a machine,
 ``halsdk ctl ...`` operates it from another shell, ``halsdk runtests
 DIR...`` runs HAL tests written in LinuxCNC's test-folder format,
-``halsdk web`` serves the HAL workbench in a browser."""
+``halsdk web [machine.ini]`` serves the HAL workbench in a browser
+(starting the machine first when given its INI file)."""
 
 from __future__ import annotations
 
@@ -40,8 +41,9 @@ def _main(argv: Optional[list[str]] = None) -> int:
                         "test.sh + expected or checkresult) "
                         "(halsdk runtests --help)")
     sub.add_parser("web", add_help=False,
-                   help="serve the HAL workbench of the running instance "
-                        "in a browser (halsdk web --help)")
+                   help="serve the HAL workbench of the running instance, "
+                        "or start machine.ini and serve its workbench, in "
+                        "a browser (halsdk web --help)")
     run = sub.add_parser(
         "run", help="start a machine from its INI file; Ctrl-C stops it")
     run.add_argument("ini", help="the machine's INI file")

@@ -48,11 +48,14 @@ from __future__ import annotations
 import os
 import signal
 import sys
-import threading
+import time
 from typing import Any, Optional, TextIO
 
 from halsdk.errors import HalError
 from halsdk.ini import IniFile
+
+#: seconds between two looks of Launcher.wait() at the stop flag
+STOP_POLL = 0.05
 
 
 class LaunchError(HalError):
@@ -83,7 +86,9 @@ class Launcher:
         self.hal: Any = None
         self.motion: Any = None
         self.io: Any = None             # the I/O controller, with [EMCIO]
-        self._stop = threading.Event()
+        # a plain flag, not a threading.Event: stop() runs in a signal
+        # handler on the thread that waits (see wait())
+        self._stopping = False
         # HAL files run in the INI file's folder, as LinuxCNC does: relative
         # paths of sourced files and loadusr programs and their arguments
         self.workdir = os.path.dirname(os.path.abspath(self.ini.path))
@@ -228,11 +233,25 @@ class Launcher:
     # ------------------------------------------------------------ run
 
     def wait(self, seconds: Optional[float] = None) -> None:
-        """Step 5: until stop() (SIGINT, SIGTERM) or ``seconds``."""
-        self._stop.wait(seconds)
+        """Step 5: until stop() (SIGINT, SIGTERM) or ``seconds``.
+
+        It looks at a flag every :data:`STOP_POLL` seconds: stop() is the
+        signal handler, run on this very thread between two bytecodes,
+        so it must take no lock.  (With a ``threading.Event``, ``set()``
+        in the handler could find the Event's lock held by the
+        interrupted ``wait()`` and wait for it forever: a machine that
+        SIGTERM never stopped.)"""
+        deadline = None if seconds is None else time.monotonic() + seconds
+        while not self._stopping:
+            left = STOP_POLL if deadline is None else \
+                min(STOP_POLL, deadline - time.monotonic())
+            if left <= 0:
+                return
+            time.sleep(left)
 
     def stop(self, *_: Any) -> None:
-        self._stop.set()
+        """Ask wait() to return (any thread, or a signal handler)."""
+        self._stopping = True
 
     def shutdown(self) -> None:
         """Step 6 (safe to call more than once)."""

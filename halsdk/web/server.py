@@ -1,11 +1,16 @@
-"""``halsdk web``: serve the workbench of the running instance.
+"""``halsdk web``: serve the workbench of the running instance, or of a
+machine it starts.
 
-    halsdk web [--instance NAME] [--host 127.0.0.1] [--port 0|N]
-               [--read-only] [--token T]
+    halsdk web [machine.ini] [--instance NAME] [--host 127.0.0.1]
+               [--port 0|N] [--read-only] [--token T]
 
-It attaches to the instance (it never creates one), prints the URL with
-its token as Jupyter does, and serves until SIGINT or SIGTERM, or until
-the instance's host ends.  It opens no browser.
+Without an INI file it attaches to the instance (it never creates one).
+With one it first starts the machine as ``halsdk run machine.ini`` does,
+in a child process of its own (:mod:`halsdk.web.machinehost`), and
+attaches to that.  It prints the URL with its token as Jupyter does, and
+serves until SIGINT or SIGTERM, or until the instance's host ends; a
+machine it started is then stopped (motion disabled, the instance
+removed).  It opens no browser.
 """
 
 from __future__ import annotations
@@ -28,14 +33,22 @@ PROG = "halsdk web"
 def parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog=PROG,
-        description="Serve the HAL workbench (the Show page: every "
-                    "component, pin, param, signal, function and thread "
-                    "with live values) of the running instance in a "
-                    "browser.  Prints the URL with its access token; "
-                    "opens nothing by itself; SIGINT or SIGTERM end it.")
+        description="Serve the HAL workbench (the Show, Scope, Machine "
+                    "and Latency pages) of the running instance in a "
+                    "browser, or start the machine of an INI file (as "
+                    "`halsdk run machine.ini` does) and serve its "
+                    "workbench.  Prints the URL with its access token; "
+                    "opens nothing by itself; SIGINT or SIGTERM end it "
+                    "(and stop the machine it started).")
+    p.add_argument("ini", nargs="?", default=None, metavar="machine.ini",
+                   help="start this machine first (its HAL files, motion "
+                        "and task controller, as `halsdk run` does), on "
+                        "--instance or $HALSDK_INSTANCE; without it, "
+                        "attach to a running instance")
     p.add_argument("--instance", metavar="NAME", default=None,
-                   help="the instance to attach to (default: "
-                        "$HALSDK_INSTANCE, else the user's instance)")
+                   help="the instance to attach to, or to start the "
+                        "machine on (default: $HALSDK_INSTANCE, else the "
+                        "user's instance)")
     p.add_argument("--host", default="127.0.0.1",
                    help="the address to listen on (default 127.0.0.1: "
                         "this computer only)")
@@ -96,6 +109,28 @@ def main(argv: Optional[list[str]] = None) -> int:
         print(f"{PROG}: --port {a.port} is not 0..65535", file=sys.stderr)
         return 2
 
+    if a.ini is None:
+        return _attach(a, token)
+    from halsdk.web.machinehost import MachineHost, StartError
+    host = MachineHost(a.ini, a.instance, prog=PROG)
+    try:
+        try:
+            host.start()
+        except StartError as exc:
+            print(f"{PROG}: {exc}", file=sys.stderr)
+            return 1
+        status = _attach(a, token)
+    finally:
+        # the workbench has let go of the instance: stop the machine
+        gone = host.stop()
+    if gone:
+        # its host ended by itself (or could not be stopped cleanly)
+        print(f"{PROG}: {gone}", file=sys.stderr)
+        return 1
+    return status
+
+
+def _attach(a: argparse.Namespace, token: str) -> int:
     from halsdk.errors import HalError
     from halsdk.hal import Hal
     try:

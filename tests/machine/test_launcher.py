@@ -152,3 +152,29 @@ def test_hal_files_run_in_the_ini_folder_and_programs_are_ended(tmp_path):
     # folder, and was ended by the shutdown, not left behind
     assert (machine / "ended").read_text() == "SIGTERM"
     assert not (elsewhere / "ended").exists()
+
+
+def test_wait_ends_when_a_signal_stops_it(tmp_path):
+    """stop() is the SIGINT/SIGTERM handler, run on the waiting thread
+    itself: wait() ends however the signal falls into it (a
+    threading.Event there could deadlock its set() against the
+    interrupted wait())."""
+    ini = tmp_path / "m.ini"
+    ini.write_text("[HAL]\nHALFILE = m.hal\n")
+    machine = Launcher(str(ini))
+    old = signal.signal(signal.SIGALRM, machine.stop)
+    try:
+        for delay in [0.001 * k for k in range(1, 40)]:
+            machine._stopping = False
+            signal.setitimer(signal.ITIMER_REAL, delay)
+            start = time.monotonic()
+            machine.wait(30)
+            assert time.monotonic() - start < 20    # it did not hang
+            assert machine._stopping
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, old)
+    machine._stopping = False
+    start = time.monotonic()
+    machine.wait(0.2)                   # no signal: the time given
+    assert time.monotonic() - start >= 0.2
