@@ -31,6 +31,24 @@ _HOST_OPS = ("loadrt", "unloadrt", "unload", "newinst", "delinst",
              "step", "loadrt_args", "recorder", "recorder_delete")
 
 
+def ends_with_this_process(chained: Optional[Callable[[], None]] = None
+                           ) -> Callable[[], None]:
+    """A ``preexec_fn`` for ``subprocess.Popen``: the child gets SIGTERM
+    from the kernel when the thread that starts it ends (with its
+    process, however it ends: ``PR_SET_PDEATHSIG``), and at once if that
+    already happened; then ``chained`` runs.  Start from the main thread
+    so that the thread lives as long as the process."""
+    parent = os.getpid()
+
+    def preexec() -> None:
+        _core.set_parent_death_signal(int(_signal.SIGTERM))
+        if os.getppid() != parent:      # the parent ended already
+            os.kill(os.getpid(), _signal.SIGTERM)
+        if chained is not None:
+            chained()
+    return preexec
+
+
 def is_halcmd_comp(name: str, pid: int) -> bool:
     """Whether a component is the ``halcmd<pid>`` of a halcmd session
     (``unload all`` and ``unloadusr all`` leave those alone)."""
@@ -147,16 +165,8 @@ class Hal:
         on_main = self._conn.host and \
             threading.current_thread() is threading.main_thread()
         if on_main:
-            parent = os.getpid()
-            chained = popen.pop("preexec_fn", None)
-
-            def preexec() -> None:
-                _core.set_parent_death_signal(int(_signal.SIGTERM))
-                if os.getppid() != parent:      # the host ended already
-                    os.kill(os.getpid(), _signal.SIGTERM)
-                if chained is not None:
-                    chained()
-            popen["preexec_fn"] = preexec
+            popen["preexec_fn"] = ends_with_this_process(
+                popen.pop("preexec_fn", None))
         child = subprocess.Popen(list(argv), **popen)
         if not on_main:
             try:

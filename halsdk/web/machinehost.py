@@ -23,7 +23,6 @@ The child's output (warnings, errors) goes to the server's stderr, its
 
 from __future__ import annotations
 
-import ctypes
 import os
 import queue
 import signal
@@ -32,28 +31,18 @@ import sys
 import threading
 from typing import Any, Optional
 
+from halsdk.hal import ends_with_this_process
+
 #: seconds the machine may take to start
 START_TIMEOUT = 120.0
 #: seconds it may take to stop after SIGINT, before SIGKILL
 STOP_TIMEOUT = 30.0
-_PR_SET_PDEATHSIG = 1
 _RUN_PREFIX = "halsdk run: "
 _STARTED = ("machine running", "HAL running")
 
 
 class StartError(Exception):
     """The machine did not start (the message says why)."""
-
-
-def _die_with_parent(parent: int) -> Any:
-    def setup() -> None:
-        # runs in the child between fork and exec: no allocation-heavy
-        # work, no locks
-        libc = ctypes.CDLL(None, use_errno=True)
-        libc.prctl(_PR_SET_PDEATHSIG, signal.SIGTERM, 0, 0, 0)
-        if os.getppid() != parent:          # the parent died already
-            os.kill(os.getpid(), signal.SIGTERM)
-    return setup
 
 
 class MachineHost:
@@ -103,7 +92,7 @@ class MachineHost:
                     args, env=env, stdin=subprocess.DEVNULL,
                     stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                     text=True, start_new_session=True,
-                    preexec_fn=_die_with_parent(os.getpid()))
+                    preexec_fn=ends_with_this_process())
             except OSError as exc:
                 raise StartError(f"cannot start the machine: "
                                  f"{exc.strerror or exc}") from None
