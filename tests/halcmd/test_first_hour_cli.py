@@ -142,3 +142,29 @@ def test_ours_whatever_comes_first_on_path(command: list[str],
                           capture_output=True, text=True, timeout=60)
     assert proc.returncode == 0 and "PATH" in proc.stdout, proc.stderr
     assert shm_left(env) == []
+
+
+@pytest.mark.parametrize("message, hint", [
+    ("HAL instance 'x' was left by a host (pid 7) that is gone, and it "
+     "could not be removed; remove it with 'halrun -U'", False),
+    ("HAL instance 'x' already has a host (pid 7)", True),
+])
+def test_halrun_gives_one_consistent_advice(message: str, hint: bool,
+                                            monkeypatch: pytest.MonkeyPatch,
+                                            capsys: pytest.CaptureFixture[str]
+                                            ) -> None:
+    """After a crashed host, halrun says what the core says (remove it
+    with halrun -U) and does not add "is another halrun running?"; that
+    question is for a live host only."""
+    import halsdk
+    from halsdk.errors import InstanceError
+    from halsdk.halcmd import cli
+
+    def refuse(create: bool = True) -> None:
+        raise InstanceError(message)
+
+    monkeypatch.setattr(halsdk, "Hal", refuse)
+    assert cli.halrun_main(["-f", "none.hal"]) == 1
+    err = capsys.readouterr().err
+    assert err.count(message) == 1, err
+    assert ("another halrun running" in err) is hint, err
