@@ -184,6 +184,38 @@ def test_a_snippet_that_does_not_run_alone_compiles(s: Snippet) -> None:
     compile(s.code, s.id, "exec")
 
 
+def _run_bounded(args: list[str], cwd: Path, env: dict[str, str],
+                 bound: float = 300) -> subprocess.CompletedProcess:
+    """Run ``args``; a snippet that does not end within ``bound`` seconds
+    (a loop meant for a real machine) is ended with SIGTERM, so that it
+    removes its HAL instance, and the test fails."""
+    with subprocess.Popen(args, cwd=cwd, env=env, text=True,
+                          stdout=subprocess.PIPE,
+                          stderr=subprocess.PIPE) as proc:
+        try:
+            out, err = proc.communicate(timeout=bound)
+        except subprocess.TimeoutExpired:
+            proc.terminate()
+            try:
+                out, err = proc.communicate(timeout=30)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                out, err = proc.communicate()
+            pytest.fail(f"{' '.join(args)} did not end within {bound} s "
+                        f"(a loop? mark it not-run):\n{out}\n{err}")
+    return subprocess.CompletedProcess(args, proc.returncode, out, err)
+
+
+def test_a_snippet_that_never_ends_is_ended(tmp_path: Path) -> None:
+    code = ("import signal, sys, time\n"
+            "signal.signal(signal.SIGTERM, lambda *a: sys.exit(3))\n"
+            "print('looping', flush=True)\n"
+            "time.sleep(60)\n")
+    with pytest.raises(pytest.fail.Exception, match="did not end within"):
+        _run_bounded([sys.executable, "-c", code], tmp_path,
+                     dict(os.environ), bound=2)
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("s", RUN, ids=lambda s: s.id)
 def test_the_snippet_runs(s: Snippet, tmp_path: Path) -> None:
@@ -205,8 +237,7 @@ def test_the_snippet_runs(s: Snippet, tmp_path: Path) -> None:
     if "hal" in needs:
         code = HAL_PRELUDE + textwrap.indent(code, "    ")
     (cwd / "snippet.py").write_text(code)
-    proc = subprocess.run([sys.executable, "snippet.py"], cwd=cwd, env=env,
-                          capture_output=True, text=True, timeout=600)
+    proc = _run_bounded([sys.executable, "snippet.py"], cwd, env)
     assert proc.returncode == 0, (
         f"{s.id} failed ({proc.returncode}):\n{code}\n{proc.stdout}\n"
         f"{proc.stderr[-4000:]}")
