@@ -39,6 +39,9 @@ def test_the_readme_says_how_to_work_from_a_checkout() -> None:
     [build] = re.findall(r"Build: ``(python -m sphinx [^`]+)``", conf)
     assert build in text, "the README gives the docs build of conf.py"
     assert 'pip install -e ".[test]"' in " ".join(conf.split())
+    for guide in ("CONTRIBUTING.md", "tests/README.md"):
+        words = " ".join(repo_path(guide).read_text().split())
+        assert 'pip install -e ".[test]"' in words, guide
 
 
 def test_the_quick_starts_plot_comes_with_the_default_install() -> None:
