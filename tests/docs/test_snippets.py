@@ -22,6 +22,7 @@ from pathlib import Path
 import pytest
 from helpers import REPO, find_test_module, repo_path
 from helpers.docblocks import code_blocks
+from helpers.running_machine import running_machine
 from helpers.snippets import (
     Snippet,
     md_snippets,
@@ -88,6 +89,10 @@ SETUPS: dict[str, Callable[[Path, dict[str, str]], None]] = {
     "mill": _mill,
 }
 
+#: ``needs running-demo``: the snippet runs while ``halsdk run`` runs the
+#: demo mill (a copy of halsdk/demo/mill), as the tutorial starts it
+RUNNING = "running-demo"
+
 #: ``needs hal``: the snippet runs inside ``with halsdk.Hal() as hal:``,
 #: the instance its page has set up before it
 HAL_PRELUDE = "import halsdk\n\nwith halsdk.Hal() as hal:\n"
@@ -136,7 +141,7 @@ def test_every_mark_is_valid() -> None:
                 assert len(s.marks[kind].split()) >= 3, \
                     f"{s.id}: '{kind}' needs its reason"
         for name in s.marks.get("needs", "").split():
-            assert name == "hal" or name in SETUPS, \
+            assert name in ("hal", RUNNING) or name in SETUPS, \
                 f"{s.id}: no setup {name!r}"
         if "continues" in s.marks:
             before = [o for o in ALL if o.page == s.page and o.line < s.line]
@@ -231,13 +236,20 @@ def test_the_snippet_runs(s: Snippet, tmp_path: Path) -> None:
     env.pop("HALSDK_PATH", None)        # a reader's machine has none
     needs = [n for c in chain for n in c.marks.get("needs", "").split()]
     for name in needs:
-        if name != "hal":
+        if name not in ("hal", RUNNING):
             SETUPS[name](cwd, env)
     code = "\n".join(c.code for c in chain)
     if "hal" in needs:
         code = HAL_PRELUDE + textwrap.indent(code, "    ")
     (cwd / "snippet.py").write_text(code)
-    proc = _run_bounded([sys.executable, "snippet.py"], cwd, env)
+    if RUNNING in needs:
+        demo = tmp_path / "demo"
+        shutil.copytree(repo_path("halsdk", "demo", "mill"), demo)
+        with running_machine(demo, ini=demo / "mill.ini") as machine:
+            env["HALSDK_INSTANCE"] = instance = machine.instance
+            proc = _run_bounded([sys.executable, "snippet.py"], cwd, env)
+    else:
+        proc = _run_bounded([sys.executable, "snippet.py"], cwd, env)
     assert proc.returncode == 0, (
         f"{s.id} failed ({proc.returncode}):\n{code}\n{proc.stdout}\n"
         f"{proc.stderr[-4000:]}")
