@@ -271,6 +271,30 @@ def test_the_readme_taste_prints_what_it_says() -> None:
         "the front page's snippet needs nothing built first"
 
 
+def _docstring_example(doc: str) -> str:
+    """The first literal block (after ``::``) of a docstring."""
+    start = doc.index("::\n") + 3
+    body = []
+    for line in doc[start:].splitlines():
+        if line.strip() and not line.startswith("    "):
+            break
+        body.append(line)
+    return textwrap.dedent("\n".join(body)).strip() + "\n"
+
+
+def test_the_packages_docstring_example_runs(tmp_path: Path) -> None:
+    """``help(halsdk)`` shows an example: it uses shipped components and
+    prints what its comment says."""
+    import halsdk
+    code = _docstring_example(halsdk.__doc__ or "")
+    (tmp_path / "example.py").write_text(code)
+    env = dict(os.environ, HALSDK_INSTANCE=f"snip-{os.getpid()}-pkgdoc")
+    env.pop("HALSDK_PATH", None)
+    proc = _run_bounded([sys.executable, "example.py"], tmp_path, env)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.strip() == "3.0", proc.stdout
+
+
 def test_captioned_examples_are_still_there() -> None:
     """The setups read these captions; the pages keep them."""
     assert "cdef" in _captioned("cython-components.rst", "clamp.pyx")
@@ -317,14 +341,7 @@ def test_the_pytest_plugins_example_passes(tmp_path: Path) -> None:
     """The example at the top of halsdk.testing's docstring (the plugin's
     page in the API docs) runs as a test file of a new project."""
     import halsdk.testing
-    doc = halsdk.testing.__doc__ or ""
-    start = doc.index("::\n") + 3
-    body = []
-    for line in doc[start:].splitlines():
-        if line.strip() and not line.startswith("    "):
-            break
-        body.append(line)
-    code = textwrap.dedent("\n".join(body)).strip() + "\n"
+    code = _docstring_example(halsdk.testing.__doc__ or "")
     assert "def test_" in code
     cwd = tmp_path / "project"
     cwd.mkdir()
