@@ -2,9 +2,12 @@
 
 Build: ``python -m sphinx -W --keep-going -b html docs docs/_build/html``.
 The API pages are made by autodoc from the installed :mod:`halsdk` (with
-its compiled core): install the project first (``pip install .`` or
-``pip install -e .``).  The source tree is not put on the path, since
-without a build it holds no compiled core.
+its compiled core): install the project first; from a checkout that is
+``pip install -e ".[test]"`` (an editable install builds the compiled
+modules next to their sources, so the checkout root imports them; after
+a plain ``pip install .``, Python started in the checkout root imports
+the uncompiled source folder).  The source tree is not put on the path,
+since without a build it holds no compiled core.
 """
 
 from __future__ import annotations

@@ -6,10 +6,15 @@ Typical use::
 
     with halsdk.Hal() as hal:
         hal.newthread("servo", 1_000_000)
-        hal.loadrt("mycomp")
-        hal.addf("mycomp.0", "servo")
-        hal.net("cmd", "mycomp.0.out", "other.0.in")
+        hal.loadrt("scale", count=2)  # components shipped with halsdk
+        hal.addf("scale.0", "servo")
+        hal.addf("scale.1", "servo")
+        hal.net("cmd", "scale.0.out", "scale.1.in")
+        hal.setp("scale.0.in", 1.5)
+        hal.setp("scale.0.gain", 2.0)
+        hal.setp("scale.1.gain", 1.0)
         hal.step(1000)            # deterministic, simulated time
+        print(hal.getp("scale.1.out"))    # 3.0
 """
 
 import importlib.util as _util

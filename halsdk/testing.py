@@ -2,13 +2,17 @@
 
 Installed with halsdk (entry point ``pytest11``), so any project can use::
 
-    def test_my_gain(hal):
-        hal.loadrt("mygain")
+    import numpy as np
+    import pytest
+
+    def test_scale_doubles(hal):
+        hal.loadrt("scale")                 # a component shipped with halsdk
         hal.newthread("servo", 1_000_000)
-        hal.addf("mygain.0", "servo")
-        trace = hal.run(100, inputs={"mygain.0.in": np.linspace(0, 1, 100)},
-                        record=["mygain.0.out"])
-        assert trace["mygain.0.out"][-1] == pytest.approx(2.0)
+        hal.addf("scale.0", "servo")
+        hal.setp("scale.0.gain", 2.0)
+        trace = hal.run(100, inputs={"scale.0.in": np.linspace(0, 1, 100)},
+                        record=["scale.0.out"])
+        assert trace["scale.0.out"][-1] == pytest.approx(2.0)
 
 The ``hal`` fixture creates an instance of its own (``HALSDK_INSTANCE`` is
 set for the test, so child processes and :func:`halsdk.component` find it),

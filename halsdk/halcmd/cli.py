@@ -26,7 +26,7 @@ options:
   -v             verbose
   -V             very verbose
   -e             echo the commands read from a file
-  -h             this help
+  -h, --help     this help
   --check FILE   check FILE's netlist without running it (see docs)
 """
 
@@ -34,6 +34,7 @@ _HALRUN_USAGE = """\
 Usage:  halrun [-I] [-U] [halcmd options] [-f] [filename.hal|filename.ini]
   -I   run an interactive halcmd after the file, before removing HAL
   -U   remove HAL instances left behind by dead processes and exit
+  -h, --help    this help
   --check FILE  check FILE's netlist without running it
   an INI file with [HAL]TWOPASS runs its [HAL]HALFILEs in two passes
   (other options are those of halcmd)
@@ -69,6 +70,10 @@ def _parse(argv: list[str], prog: str) -> _Options:
             opts.check = True
             i += 1
             continue
+        if arg == "--help":
+            # what a newcomer types first: the usage, like -h
+            sys.stdout.write(usage)
+            raise SystemExit(0)
         if not arg.startswith("-") or arg == "-":
             break
         letters = arg[1:]
@@ -182,13 +187,21 @@ def _interactive(ex: CommandRunner) -> None:
 
 
 def _run(ex: CommandRunner, opts: _Options, prog: str) -> int:
-    """Run the file, the command words or the prompt; exit status."""
+    """Run the file, the command words or the prompt; exit status.
+
+    halrun's status is the file's: a command mistyped at its interactive
+    prompt was answered there and does not fail the session (the
+    reference's halrun ignores its interactive halcmd's status too)."""
+    counted: Optional[int] = None     # the errors that count, once known
     try:
         if opts.file is not None and prog == "halrun" and \
                 opts.file.endswith(".ini"):
             status = _twopass(ex, opts.file)
             if opts.interactive_after:
-                _interactive(ex)
+                try:
+                    _interactive(ex)
+                except Quit:
+                    pass
             return status
         if opts.file is not None:
             if opts.file == "-":
@@ -200,10 +213,12 @@ def _run(ex: CommandRunner, opts: _Options, prog: str) -> int:
         elif prog == "halcmd" or not opts.interactive_after:
             _interactive(ex)
         if opts.interactive_after and prog == "halrun":
+            counted = ex.errors
             _interactive(ex)
     except Quit:
         pass
-    return 1 if ex.errors else 0
+    errors = ex.errors if counted is None else counted
+    return 1 if errors else 0
 
 
 def _twopass(ex: CommandRunner, path: str) -> int:
@@ -291,8 +306,8 @@ def _halcmd_main(argv: Optional[list[str]] = None) -> int:
         print(f"halcmd: {exc}", file=sys.stderr)
         return 1
     except HalError as exc:
-        print(f"halcmd: no HAL instance to attach to ({exc}); "
-              "start one with halrun", file=sys.stderr)
+        # the error names the instance and says how to start one: once
+        print(f"halcmd: {exc}", file=sys.stderr)
         return 1
     with hal:
         try:
@@ -366,12 +381,23 @@ def _halrun_main(argv: Optional[list[str]] = None) -> int:
             _teardown(hal, ex, opts)
 
 
+_MAIN_USAGE = """\
+usage: python -m halsdk.halcmd halrun|halcmd [options]
+  (also: halsdk halrun|halcmd [options]) this halsdk's halrun and halcmd,
+  whichever halrun/halcmd comes first on PATH; 'halrun --help' and
+  'halcmd --help' give their options
+"""
+
+
 def main(argv: Optional[list[str]] = None) -> int:
-    """``python -m halsdk.halcmd.cli halcmd|halrun [options]``."""
+    """``python -m halsdk.halcmd halcmd|halrun [options]`` (also
+    ``python -m halsdk.halcmd.cli``)."""
     argv = sys.argv[1:] if argv is None else argv
+    if argv and argv[0] in ("-h", "--help"):
+        sys.stdout.write(_MAIN_USAGE)
+        return 0
     if not argv or argv[0] not in ("halcmd", "halrun"):
-        sys.stderr.write("usage: python -m halsdk.halcmd.cli "
-                         "halcmd|halrun [options]\n")
+        sys.stderr.write(_MAIN_USAGE)
         return 2
     prog, rest = argv[0], argv[1:]
     return (halcmd_main if prog == "halcmd" else halrun_main)(rest)

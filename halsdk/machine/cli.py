@@ -12,6 +12,15 @@ from typing import Optional
 
 from halsdk import console
 
+#: ``halsdk --help``'s words: plain text (the docstring is reST)
+_DESCRIPTION = """\
+halsdk run machine.ini   starts a machine
+halsdk ctl ...           operates it from another shell
+halsdk runtests DIR...   runs HAL tests in LinuxCNC's test-folder format
+halsdk web               serves the HAL workbench in a browser
+halsdk halrun|halcmd ... this halsdk's halrun and halcmd, whichever
+                         halrun/halcmd comes first on PATH"""
+
 
 def main(argv: Optional[list[str]] = None) -> int:
     """Console entry point: :func:`_main` under the broken-pipe rule
@@ -31,7 +40,14 @@ def _main(argv: Optional[list[str]] = None) -> int:
     if args and args[0] == "web":
         from halsdk.web.server import main as web_main
         return web_main(args[1:])
-    p = argparse.ArgumentParser(prog="halsdk", description=__doc__)
+    if args and args[0] in ("halrun", "halcmd"):
+        # this halsdk's, whichever halrun/halcmd comes first on PATH
+        from halsdk.halcmd.cli import halcmd_main, halrun_main
+        return (halrun_main if args[0] == "halrun" else halcmd_main)(
+            args[1:])
+    p = argparse.ArgumentParser(
+        prog="halsdk", description=_DESCRIPTION,
+        formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="command", required=True)
     sub.add_parser("ctl", add_help=False,
                    help="operate a running machine: status, estop, on, "
@@ -44,6 +60,12 @@ def _main(argv: Optional[list[str]] = None) -> int:
                    help="serve the HAL workbench of the running instance, "
                         "or start machine.ini and serve its workbench, in "
                         "a browser (halsdk web --help)")
+    sub.add_parser("halrun", add_help=False,
+                   help="this halsdk's halrun, whatever comes first on "
+                        "PATH (halsdk halrun --help)")
+    sub.add_parser("halcmd", add_help=False,
+                   help="this halsdk's halcmd, whatever comes first on "
+                        "PATH (halsdk halcmd --help)")
     run = sub.add_parser(
         "run", help="start a machine from its INI file; Ctrl-C stops it")
     run.add_argument("ini", help="the machine's INI file")

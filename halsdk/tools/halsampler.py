@@ -27,7 +27,25 @@ PROG = "halsampler"
 POLL_S = 0.01
 
 
+USAGE = """\
+usage: halsampler [-c CHAN] [-n COUNT] [-t] [FILENAME]
+
+Prints the records of the stream sampler.CHAN (made by 'loadrt sampler')
+of the HAL instance $HALSDK_INSTANCE, one line per sample.
+  -c CHAN   the sampler channel (default 0)
+  -n COUNT  exit with status 0 after COUNT samples (default: run until
+            killed, then exit with status 1)
+  -t        print the sample number first
+  -h, --help  this help
+  FILENAME  write to this file instead of stdout
+"""
+
+
 class _Usage(Exception):
+    pass
+
+
+class _Help(Exception):
     pass
 
 
@@ -37,6 +55,8 @@ def _parse(argv: Sequence[str]) -> tuple[int, int, bool, Optional[str]]:
     i = 0
     while i < len(args):
         a = args[i]
+        if a in ("-h", "--help"):
+            raise _Help
         if a.startswith("-") and len(a) > 1:
             opt = a[1]
             if opt == "t" and len(a) == 2:
@@ -129,6 +149,9 @@ def _main(argv: Optional[Sequence[str]] = None) -> int:
         argv = sys.argv[1:]
     try:
         chan, count, tag, filename = _parse(argv)
+    except _Help:
+        sys.stdout.write(USAGE)
+        return 0
     except _Usage as e:
         print(e, file=sys.stderr)
         return 1

@@ -78,7 +78,23 @@ def parse_line(line: str, types: Sequence[int]) -> list:
     return values
 
 
+USAGE = """\
+usage: halstreamer [-c CHAN] [FILENAME]
+
+Writes each line of FILENAME (default stdin) as a record to the stream
+streamer.CHAN (made by 'loadrt streamer') of the HAL instance
+$HALSDK_INSTANCE: one value per pin, separated by blanks; lines starting
+with # are skipped.
+  -c CHAN     the streamer channel (default 0)
+  -h, --help  this help
+"""
+
+
 class _Usage(Exception):
+    pass
+
+
+class _Help(Exception):
     pass
 
 
@@ -88,6 +104,8 @@ def _parse(argv: Sequence[str]) -> tuple[int, Optional[str]]:
     i = 0
     while i < len(args):
         a = args[i]
+        if a in ("-h", "--help"):
+            raise _Help
         if a.startswith("-") and len(a) > 1:
             if a[1] != "c":
                 raise _Usage(f"ERROR: unknown option '{a[1]}'")
@@ -149,6 +167,9 @@ def _main(argv: Optional[Sequence[str]] = None) -> int:
         argv = sys.argv[1:]
     try:
         chan, filename = _parse(argv)
+    except _Help:
+        sys.stdout.write(USAGE)
+        return 0
     except _Usage as e:
         print(e, file=sys.stderr)
         return 1

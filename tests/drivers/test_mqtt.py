@@ -7,7 +7,6 @@ import json
 import logging
 import os
 import queue
-import shutil
 import signal
 import subprocess
 import sys
@@ -19,6 +18,7 @@ import paho.mqtt.client as mqtt
 import pytest
 from helpers import repo_path
 from helpers.fixtures import factory
+from helpers.tools import need_program, unavailable
 from paho.mqtt.enums import CallbackAPIVersion
 
 import halsdk
@@ -50,7 +50,7 @@ def broker(tmp_path):
     try:
         find_mosquitto()
     except RuntimeError as exc:
-        pytest.fail(str(exc))
+        unavailable(f"{exc} (apt-get install mosquitto)")
     made = []
 
     def make(extra: str = "", port: int = 0) -> Mosquitto:
@@ -392,8 +392,8 @@ def test_wrong_credentials(hal, source, broker, bridges, caplog):
 def make_certs(folder: str) -> dict[str, str]:
     """A throwaway CA, a server certificate for 127.0.0.1 and a client
     certificate, made with the openssl command."""
-    if shutil.which("openssl") is None:
-        pytest.fail("openssl is needed to make test certificates")
+    need_program("openssl", "openssl", "the TLS tests make their "
+                 "certificates with it")
     paths = {k: os.path.join(folder, k) for k in (
         "ca.key", "ca.crt", "server.key", "server.crt", "client.key",
         "client.crt", "ext.cnf")}
