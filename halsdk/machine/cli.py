@@ -17,7 +17,7 @@ _DESCRIPTION = """\
 halsdk run machine.ini   starts a machine
 halsdk ctl ...           operates it from another shell
 halsdk runtests DIR...   runs HAL tests in LinuxCNC's test-folder format
-halsdk web               serves the HAL workbench in a browser
+halsdk web [machine.ini] serves the HAL workbench in a browser
 halsdk halrun|halcmd ... this halsdk's halrun and halcmd, whichever
                          halrun/halcmd comes first on PATH"""
 

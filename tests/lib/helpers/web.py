@@ -3,9 +3,10 @@ Python API, the system chromium as the executable: nothing is
 downloaded), and ``halsdk web`` served on the test's instance.
 
 Without chromium or playwright the browser tests are skipped, except in
-CI (``CI=true``), where ``.ci/run`` installs chromium and their absence
-is an error.  Use: ``from helpers.web import browser, serve, stop``
-(``browser`` is a module-scoped fixture).
+CI (``CI`` set, :func:`helpers.tools.unavailable`), where ``.ci/run``
+installs chromium and their absence is an error.  Use: ``from
+helpers.web import browser, serve, stop`` (``browser`` is a
+module-scoped fixture).
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from typing import Any
 import pytest
 
 from helpers.running_machine import halsdk_command
+from helpers.tools import unavailable
 
 TOKEN = "browser-test-token-42"
 
@@ -35,10 +37,8 @@ def chromium_path() -> str | None:
 
 
 def _unavailable(why: str) -> None:
-    if os.environ.get("CI") == "true":
-        pytest.fail(f"browser tests in CI: {why} (.ci/run installs "
-                    "Debian's chromium; playwright is a test extra)")
-    pytest.skip(why)
+    unavailable(f"browser tests: {why} (.ci/run installs Debian's "
+                "chromium; playwright is a test extra)")
 
 
 @pytest.fixture(scope="module")
