@@ -29,6 +29,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import re
 import sys
 import time
 from dataclasses import asdict, dataclass, field
@@ -94,7 +95,10 @@ class SimMachine(Machine):
     whole task cycles of that time but the last, as one step of the servo
     thread, so it sees the machine at rest in the same task cycle as when
     it looks every cycle: the same servo cycles, the same program time,
-    far fewer Python cycles.
+    far fewer Python cycles.  Moves not yet taken by motmod (which may
+    refuse them) and messages not yet collected keep it looking; an error
+    that motmod meets within a skipped stretch (a following error, a
+    limit switch) is seen at its end.
     """
 
     steps = 10                          #: servo cycles per task cycle
@@ -141,9 +145,11 @@ class SimMachine(Machine):
                 return 0                # a command in progress
         elif state is not InterpState.WAITING:
             return 0
+        if self.motion.queue_pending() or self.motion.messages_waiting():
+            return 0                    # a move motmod may still refuse
         d = self.motion.status_dict()
-        if self.motion._pending or not d["enabled"] or d["homing"]:
-            return 0                    # a message to collect, ...
+        if not d["enabled"] or d["homing"]:
+            return 0
         vmax = math.sqrt(sum(a["vel_limit"] ** 2 for a in d["axes"][:3]))
         if not vmax > 0:
             return 0
@@ -230,12 +236,24 @@ def simulate(ini_path: str, program: str, *, timeout: float = 86400.0,
     return result
 
 
+def _core(text: str) -> str:
+    """A message without the ``file:line:`` the task puts before motion's
+    own and without its ``; ...`` tail: one event, told twice."""
+    return re.sub(r"^\S+:\d+(:\d+)?: ", "", text).split(";")[0]
+
+
 def _error(result: SimResult, kind: str, text: str) -> None:
     if kind != "error" or text in result.errors:
         return
     result.errors.append(text)
-    if _is_limit(text) and text not in result.limit_hits:
-        result.limit_hits.append(text)
+    if not _is_limit(text):
+        return
+    for i, hit in enumerate(result.limit_hits):
+        if _core(hit) == _core(text):       # the same hit, told twice:
+            if _core(text) != text:         # keep the one with file:line
+                result.limit_hits[i] = text
+            return
+    result.limit_hits.append(text)
 
 
 def _session(machine: SimMachine, result: SimResult, ini: Any,

@@ -153,7 +153,7 @@ def test_a_machine_that_does_not_start(tmp_path):
 
 moves = st.lists(
     st.tuples(st.sampled_from(["G0", "G1"]),
-              st.floats(0, 150), st.floats(0, 100), st.floats(-20, 0)),
+              st.floats(0, 230), st.floats(0, 100), st.floats(-20, 0)),
     min_size=1, max_size=6)
 
 
@@ -163,8 +163,9 @@ moves = st.lists(
 @given(moves=moves, change=st.booleans())
 def test_skipping_task_cycles_changes_no_servo_cycle(tmp_path, monkeypatch,
                                                      moves, change):
-    """The skip of SimMachine: the same program time, servo cycles and
-    following errors as a task that looks every task cycle."""
+    """The skip of SimMachine: the same program time, servo cycles,
+    following errors and errors as a task that looks every task cycle,
+    also when motmod refuses a move beyond the soft limit (X > 201)."""
     from halsdk.machine.simulate import simulate as run
     monkeypatch.setenv("HALSDK_INSTANCE", private_instance_name())
     folder = tmp_path / f"m{os.urandom(4).hex()}"
@@ -181,7 +182,10 @@ def test_skipping_task_cycles_changes_no_servo_cycle(tmp_path, monkeypatch,
     results = [run(str(ini), str(program), skipping=s, out=io.StringIO(),
                    err=io.StringIO()) for s in (False, True)]
     every, skipped = results
-    assert every.ok and skipped.ok, every.errors + skipped.errors
+    beyond = any(x > 201 for _, x, _, _ in moves)
+    assert every.ok is not beyond, every.errors
+    assert skipped.errors == every.errors
+    assert skipped.limit_hits == every.limit_hits
     assert skipped.program_time == every.program_time
     assert skipped.servo_cycles == every.servo_cycles
     assert skipped.max_following_error == every.max_following_error
