@@ -182,8 +182,8 @@ def simulate(ini_path: str, program: str, *, timeout: float = 86400.0,
     :class:`SimResult`.  ``timeout``: seconds of machine time for the
     program (and again for homing).  ``strict``: problems of the INI
     file are errors.  ``skipping``: False looks every task cycle (the
-    same result, slower: see :class:`SimMachine`).  Raises HalError when the machine
-    cannot be started."""
+    same result, slower: see :class:`SimMachine`).  Raises HalError when
+    the machine cannot be started."""
     from halsdk.machine.launcher import Launcher
     from halsdk.machine.runner import _cycle_time
 
