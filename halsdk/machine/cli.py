@@ -83,7 +83,35 @@ def _main(argv: Optional[list[str]] = None) -> int:
                           "a LinuxCNC section (a typo), a section or key "
                           "given twice, [KINS]JOINTS that disagrees with "
                           "the [JOINT_n] sections or the HAL files")
+    run.add_argument("--simulate", action="store_true",
+                     help="run a program (--program) in stepped, simulated "
+                          "time as fast as possible: start the machine, "
+                          "home it (unless [TRAJ]NO_FORCE_HOMING), run "
+                          "the program, print the program time, the "
+                          "largest following error per joint, limit hits "
+                          "and errors; exit status 1 on any error")
+    run.add_argument("--program", metavar="FILE",
+                     help="with --simulate: the G-code program to run "
+                          "(relative to the current folder, else to the "
+                          "INI file's folder)")
+    run.add_argument("--json", metavar="FILE",
+                     help="with --simulate: also write the result as JSON")
+    run.add_argument("--timeout", type=float, default=86400.0,
+                     metavar="SECONDS",
+                     help="with --simulate: machine time the program (and "
+                          "homing) may take before it counts as an error "
+                          "(default 86400)")
     a = p.parse_args(args)
+    if a.command == "run" and (a.simulate or a.program or a.json):
+        if not (a.simulate and a.program):
+            p.error("--simulate needs --program FILE, and --program and "
+                    "--json go with --simulate")
+        if a.stepped or a.seconds is not None:
+            p.error("--simulate is stepped and ends with the program: "
+                    "no --stepped or --seconds")
+        from halsdk.machine.simulate import main_simulate
+        return main_simulate(a.ini, a.program, a.json, a.timeout,
+                             strict=a.strict)
     if a.command == "run":
         from halsdk.machine.launcher import run as run_machine
         return run_machine(a.ini, seconds=a.seconds,

@@ -101,9 +101,10 @@ class Executor(C.Canon):
 
     def at_rest(self) -> bool:
         """The move queue is drained and nothing moves."""
-        if not self.motion.status_dict()["enabled"]:
+        d = self.motion.status_dict()       # one snapshot per look
+        if not d["enabled"]:
             raise ExecutorError("motion is disabled")
-        return self.motion.moves_done()
+        return self.motion.moves_done(d)
 
     def _io_idle(self) -> bool:
         if self.io.tool_state is not ToolState.IDLE:

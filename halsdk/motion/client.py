@@ -275,13 +275,15 @@ class Motion:
         return (self._hal is not None and
                 not self._hal.info()["threads_running"])
 
-    def moves_done(self, status: Optional[Status] = None) -> bool:
+    def moves_done(self, status: Optional[Status | dict] = None) -> bool:
         """Every queued move was taken and has run, and nothing moves
         (what wait_done waits for); without waiting.  Raises
         :class:`QueueRejected` when motmod refused a queued record that
-        was not reported yet: a refused queue is drained, not done."""
-        if status is None:
-            d = self.status_dict()
+        was not reported yet: a refused queue is drained, not done.
+        ``status``: a :class:`Status` or a :meth:`status_dict` already
+        taken this cycle (default: a new snapshot)."""
+        if status is None or isinstance(status, dict):
+            d = self.status_dict() if status is None else status
             if d["queue_err_count"] != self._q_epoch:
                 self._check_queue()
             return (d["queue_taken"] == self._ch.queue_state()[0]
@@ -1117,6 +1119,16 @@ class Motion:
             raise MotionError(str(e)) from None
         self._pull_messages()
         return d
+
+    def messages_waiting(self) -> bool:
+        """True when motmod posted a message that :meth:`errors` has not
+        returned yet (cheap: no status snapshot)."""
+        if self._pending:
+            return True
+        try:
+            return self._ch.msg_count() != self._msg_read
+        except _channel.ChannelError as e:
+            raise MotionError(str(e)) from None
 
     def errors(self) -> list[str]:
         """The realtime error messages posted since the last call."""
