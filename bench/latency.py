@@ -9,8 +9,12 @@ running one ``timedelta`` (``timedelta.0`` in the base thread,
 timedelta's ``jitter`` (the largest deviation of an interval from the
 period) and ``max`` (the longest interval) are read.
 
-Ours runs in a private HAL instance of this process (SCHED_FIFO with
-locked memory when it may, and with normal scheduling: ``--sched``).
+Ours runs in a private HAL instance, with SCHED_FIFO and locked memory
+when it may and with normal scheduling (``--sched``), in a child process
+started in a session of its own, as the reference's rtapi_app runs: with
+the kernel's autogroup scheduling a session is a scheduling group, and
+under normal scheduling the group decides how soon a thread runs
+(``--same-session`` runs it in this process instead).
 The reference runs the same HAL file with its own ``halrun`` through the
 project's ``reference`` tool (one reference HAL at a time: the bench
 holds the reference lock); its rtapi_app is setuid root and says which
@@ -25,6 +29,7 @@ Run: ``python bench/latency.py [--seconds 10] [--repeat 3]
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import re
 import statistics
@@ -84,6 +89,28 @@ def run_ours(base: int, servo: int, seconds: float, warmup: float,
                    for i, pin in READ}
         hal.stop()
     return Run(figures, sched)
+
+
+def run_ours_apart(base: int, servo: int, seconds: float, warmup: float,
+                   realtime: bool) -> Run:
+    """:func:`run_ours` in a child process in a session of its own, as
+    the reference's rtapi_app runs (it starts a session): with the
+    kernel's autogroup scheduling, a session is a scheduling group, so
+    both sides compete for the processors the same way."""
+    cmd = [sys.executable, os.path.abspath(__file__), "--ours-once",
+           "realtime" if realtime else "normal", "--base", str(base),
+           "--servo", str(servo), "--seconds", str(seconds),
+           "--warmup", str(warmup)]
+    proc = subprocess.run(cmd, stdin=subprocess.DEVNULL,
+                          capture_output=True, text=True,
+                          start_new_session=True,
+                          timeout=warmup + seconds + 120)
+    if proc.returncode != 0:
+        raise RuntimeError(f"our run failed ({proc.returncode}):\n"
+                           + (proc.stdout + proc.stderr)[-2000:])
+    data = json.loads(proc.stdout.splitlines()[-1])
+    return Run({(i, pin): v for i, pin, v in data["figures"]},
+               data["sched"])
 
 
 # ------------------------------------------------------------ reference
@@ -207,6 +234,12 @@ def main(argv: Optional[list[str]] = None) -> int:
     add_repeat(p, 1, "runs per side, alternating; the table shows the "
                      "median")
     add_no_reference(p)
+    p.add_argument("--same-session", action="store_true",
+                   help="run our side in this process's session (default: "
+                        "a child in a session of its own, as the "
+                        "reference's rtapi_app)")
+    p.add_argument("--ours-once", choices=("realtime", "normal"),
+                   help=argparse.SUPPRESS)
     p.add_argument("--sched", choices=("both", "realtime", "normal"),
                    default="both",
                    help="our threads with realtime scheduling (SCHED_FIFO "
@@ -218,13 +251,20 @@ def main(argv: Optional[list[str]] = None) -> int:
         p.error("--seconds must be > 0, --warmup >= 0")
     if not 0 < a.base < a.servo:
         p.error("--base must be > 0 and shorter than --servo")
+    if a.ours_once:
+        run = run_ours(a.base, a.servo, a.seconds, a.warmup,
+                       a.ours_once == "realtime")
+        print(json.dumps({"sched": run.sched, "figures": [
+            [i, pin, v] for (i, pin), v in run.figures.items()]}))
+        return 0
+    ours_run = run_ours if a.same_session else run_ours_apart
     with_ref = use_reference(not a.no_reference, REFERENCE_HALRUN)
     ours: dict[str, list[Run]] = {"realtime": [], "normal": []}
     ref: list[Run] = []
     for _ in range(a.repeat):
         for sched in ours:
             if a.sched in ("both", sched):
-                ours[sched].append(run_ours(a.base, a.servo, a.seconds,
+                ours[sched].append(ours_run(a.base, a.servo, a.seconds,
                                             a.warmup, sched == "realtime"))
         if with_ref:
             ref.append(run_reference(a.base, a.servo, a.seconds, a.warmup))
