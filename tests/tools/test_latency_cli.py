@@ -181,7 +181,9 @@ def test_an_unwritable_file_is_an_error_after_the_summary(tmp_path):
     assert "Traceback" not in r.stderr
 
 
-def test_sigterm_ends_it_with_the_summary(tmp_path):
+@pytest.mark.parametrize("signum, why", [(signal.SIGTERM, "SIGTERM"),
+                                         (signal.SIGINT, "interrupted")])
+def test_a_signal_ends_it_with_the_summary(tmp_path, signum, why):
     proc = subprocess.Popen([HALSDK, "latency", "--interval", "0.2"],
                             cwd=tmp_path, stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True,
@@ -193,7 +195,7 @@ def test_sigterm_ends_it_with_the_summary(tmp_path):
             seen.append(line)
             if " s  base: max " in line:
                 break
-        proc.send_signal(signal.SIGTERM)
+        proc.send_signal(signum)
         out, err = proc.communicate(timeout=30)
     finally:
         if proc.poll() is None:
@@ -201,7 +203,7 @@ def test_sigterm_ends_it_with_the_summary(tmp_path):
             proc.wait()
     out = "".join(seen) + out
     assert proc.returncode == 0, err
-    assert re.search(r"^summary: [\d.]+ s \(SIGTERM\), ", out, re.M)
+    assert re.search(rf"^summary: [\d.]+ s \({why}\), ", out, re.M)
     assert set(summary_rows(out)) == {"base", "servo"}
     assert (tmp_path / "latency.csv").exists()
     assert (tmp_path / "latency.png").read_bytes()[:8] == PNG_MAGIC
