@@ -2,7 +2,8 @@
 ``halsdk ctl ...`` operates it from another shell, ``halsdk runtests
 DIR...`` runs HAL tests written in LinuxCNC's test-folder format,
 ``halsdk web [machine.ini]`` serves the HAL workbench in a browser
-(starting the machine first when given its INI file)."""
+(starting the machine first when given its INI file), ``halsdk latency``
+runs the latency test in a terminal."""
 
 from __future__ import annotations
 
@@ -18,6 +19,7 @@ halsdk run machine.ini   starts a machine
 halsdk ctl ...           operates it from another shell
 halsdk runtests DIR...   runs HAL tests in LinuxCNC's test-folder format
 halsdk web [machine.ini] serves the HAL workbench in a browser
+halsdk latency           runs a latency test of this computer
 halsdk halrun|halcmd ... this halsdk's halrun and halcmd, whichever
                          halrun/halcmd comes first on PATH"""
 
@@ -40,6 +42,9 @@ def _main(argv: Optional[list[str]] = None) -> int:
     if args and args[0] == "web":
         from halsdk.web.server import main as web_main
         return web_main(args[1:])
+    if args and args[0] == "latency":
+        from halsdk.tools.latency_cli import main as latency_main
+        return latency_main(args[1:])
     if args and args[0] in ("halrun", "halcmd"):
         # this halsdk's, whichever halrun/halcmd comes first on PATH
         from halsdk.halcmd.cli import halcmd_main, halrun_main
@@ -66,6 +71,10 @@ def _main(argv: Optional[list[str]] = None) -> int:
     sub.add_parser("halcmd", add_help=False,
                    help="this halsdk's halcmd, whatever comes first on "
                         "PATH (halsdk halcmd --help)")
+    sub.add_parser("latency", add_help=False,
+                   help="the latency test: how regularly this computer "
+                        "runs a base and a servo thread; live figures, a "
+                        "summary and histograms (halsdk latency --help)")
     run = sub.add_parser(
         "run", help="start a machine from its INI file; Ctrl-C stops it")
     run.add_argument("ini", help="the machine's INI file")

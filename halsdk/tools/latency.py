@@ -472,9 +472,10 @@ class LatencyTest:
         """Thread ``s``'s figures, in ns (None: nothing measured yet):
         ``max``/``min``/``last`` latency, ``jitter`` (the largest
         deviation from the period), ``interval_max`` (the longest time
-        between two runs), the thread's ``cycles`` and ``overruns``; with
-        a histogram, ``avg`` and ``sdev`` of the latency and ``samples``
-        (the latencies it counts)."""
+        between two runs), ``interval_last`` (the last one), the
+        thread's ``cycles`` and ``overruns``; with a histogram, ``avg``
+        and ``sdev`` of the latency and ``samples`` (the latencies it
+        counts)."""
         pin = self._pin
         lo = pin(f"{s.hist}.latency-min").value
         hi = pin(f"{s.hist}.latency-max").value
@@ -490,6 +491,8 @@ class LatencyTest:
             "last": pin(f"{s.hist}.latency").value if measured else None,
             "jitter": pin(f"{s.td}.jitter").value if measured else None,
             "interval_max": (pin(f"{s.td}.max").value or None)
+            if measured else None,
+            "interval_last": (pin(f"{s.td}.out").value or None)
             if measured else None,
             "avg": None, "sdev": None, "samples": None,
         }

@@ -24,7 +24,7 @@ ROOT = str(REPO)
 DOCS = os.path.join(ROOT, "docs")
 PAGES = ["index", "concepts", "tutorial", "components", "halcmd", "runtests",
          "halcompile", "python-api", "cython-components", "c-components",
-         "motion", "running", "machine", "tooltable", "gcode", "drivers",
+         "motion", "running", "latency", "machine", "tooltable", "gcode", "drivers",
          "driver-realtime", "driver-sim-io", "driver-cia402", "driver-whb04b",
          "driver-mqtt", "driver-candbc", "driver-mb2hal", "homing",
          "kinematics", "architecture", "design", "compat", "benchmarks",
