@@ -17,12 +17,14 @@ Typical use::
         print(hal.getp("scale.1.out"))    # 3.0
 """
 
-import importlib.util as _util
-
-if _util.find_spec("halsdk.core._core") is None:    # a checkout, not built
+try:
+    __import__("halsdk.core._core")
+except ModuleNotFoundError as _exc:      # a checkout, not built
+    if _exc.name != "halsdk.core._core":
+        raise
     raise ModuleNotFoundError(
         f"halsdk is not built here ({__path__[0]}): pip install -e .",
-        name="halsdk.core._core")
+        name="halsdk.core._core") from None
 from halsdk.component import Component, component
 from halsdk.core import _core  # noqa: E402
 from halsdk.core.instance import cleanup

@@ -2,17 +2,13 @@
 
 from __future__ import annotations
 
-import fnmatch
 import os
-import signal as _signal
-import subprocess
 import time
 from collections.abc import Iterable, Sequence
-from typing import Any, Callable, Optional, Union
+from typing import TYPE_CHECKING, Any, Callable, Optional, Union
 
 from halsdk.component import Component
-from halsdk.core import _core, channel, instance
-from halsdk.core.records import Record
+from halsdk.core import _core, instance
 from halsdk.errors import (
     ConflictError,
     InvalidError,
@@ -20,8 +16,17 @@ from halsdk.errors import (
     NotPermittedError,
     Rule,
 )
-from halsdk.loader import Registry
 from halsdk.types import Direction, HalType, parse_type, type_word
+
+if TYPE_CHECKING:
+    import subprocess
+
+    from halsdk.core.records import Record
+
+# fnmatch, signal, subprocess, halsdk.core.channel, halsdk.core.records
+# and halsdk.loader are imported where they are used: a halcmd or halrun
+# that does not need them starts faster
+# (tests/halcmd/test_startup_imports.py)
 
 Value = Union[bool, int, float, str]
 
@@ -82,6 +87,7 @@ class Hal:
         conn = self._conn
         with conn.lock:
             if conn.host and conn.registry is None:
+                from halsdk.loader import Registry
                 conn.registry = Registry()
                 conn.closers.append(conn.registry.unload_all)
                 for op in _HOST_OPS:
@@ -161,6 +167,8 @@ class Hal:
         elsewhere (an attached ``halcmd``, another thread of the host) a
         small ``halsdk-guard`` process waits on pidfds of the host and the
         program and ends with whichever ends first."""
+        import signal as _signal
+        import subprocess
         import threading
         on_main = self._conn.host and \
             threading.current_thread() is threading.main_thread()
@@ -180,6 +188,7 @@ class Hal:
     def _call_host(self, op: str, *args: Any, **kwargs: Any) -> Any:
         if self._conn.host:
             return getattr(self, "_host_" + op)(*args, **kwargs)
+        from halsdk.core import channel
         return channel.request(self._conn.shm, op, *args, **kwargs)
 
     # ------------------------------------------------------------ modules
@@ -281,7 +290,8 @@ class Hal:
         if comp.pid == os.getpid() or not comp.alive:
             _core.comp_exit(comp.id)
             return
-        os.kill(comp.pid, _signal.SIGTERM)
+        import signal
+        os.kill(comp.pid, signal.SIGTERM)
         deadline = time.monotonic() + timeout
         while time.monotonic() < deadline:
             if not comp.exists:
@@ -637,6 +647,7 @@ class Hal:
         runtime folder (mode 0700), beside the host's request socket.
         TrustError when that folder is another user's, a link, or open to
         others (docs/concepts.rst, "the trust checks")."""
+        from halsdk.core import channel
         if purpose not in channel.SOCKET_PURPOSES:
             raise InvalidError(f"socket purpose {purpose!r}: one of "
                                f"{', '.join(channel.SOCKET_PURPOSES)}")
@@ -666,6 +677,7 @@ class Hal:
         # the names come with the handles, taken under the lock: an
         # object deleted meanwhile by another process cannot make the
         # listing fail (its handle is then stale, as any handle can be)
+        import fnmatch
         pats = [pattern] if isinstance(pattern, str) else list(pattern)
         found = [(name, it) for name, it in _core.named_items(kind)
                  if any(fnmatch.fnmatchcase(name, p) for p in pats)]
@@ -685,6 +697,7 @@ class Hal:
         moment and never fails because another process loads or unloads
         components meanwhile.  halcmd's ``show``, ``list`` and ``save``
         print snapshots."""
+        import fnmatch
         self._check_kind(kind)
         pats = [pattern] if isinstance(pattern, str) else list(pattern)
         found = [r for r in _core.snapshot(kind)

@@ -29,13 +29,9 @@ from __future__ import annotations
 
 import importlib
 import importlib.machinery
-import importlib.util
 import os
 import re
-import shutil
 import sys
-import tempfile
-from dataclasses import dataclass, field
 from types import ModuleType
 from typing import Any, Optional
 
@@ -89,6 +85,10 @@ def _import_file(name: str, path: str,
     values.  ``package``: the package the module belongs to (a shipped
     one), whose siblings it imports relatively.
     """
+    # imported here, not at start-up: halcmd and halrun start faster
+    import importlib.util
+    import shutil
+    import tempfile
     n = _imported.get(path, 0)
     _imported[path] = n + 1
     qual = f"halsdk._loaded.{name}"
@@ -126,6 +126,7 @@ USER_ARGV_PARAM = "halsdk_argv"
 
 def import_component(name: str) -> ModuleType:
     """Import the module of component ``name`` by the search order."""
+    import importlib.util
     if not _MODULE_NAME.match(name):
         raise InvalidError(f"'{name}' is not a component module name")
     for folder in search_path():
@@ -269,12 +270,33 @@ def parse_modparams(name: str, module: object, args: tuple,
 
 # ---------------------------------------------------------------- registry
 
-@dataclass
 class Loaded:
-    name: str
-    module: ModuleType
-    comp_ids: list[int] = field(default_factory=list)
-    args: str = ""          # the load line's parameters, as saved
+    """A module this host loaded: its components and its load line's
+    parameters (as saved).  A plain class, not a dataclass: importing
+    dataclasses would slow the start of every halrun."""
+
+    __hash__ = None     # type: ignore[assignment]  # mutable, as before
+
+    def __init__(self, name: str, module: ModuleType,
+                 comp_ids: Optional[list[int]] = None,
+                 args: str = "") -> None:
+        self.name = name
+        self.module = module
+        self.comp_ids: list[int] = [] if comp_ids is None else comp_ids
+        self.args = args
+
+    def _key(self) -> tuple:
+        return (self.name, self.module, self.comp_ids, self.args)
+
+    def __eq__(self, other: object) -> bool:
+        if other.__class__ is not self.__class__:
+            return NotImplemented
+        assert isinstance(other, Loaded)
+        return self._key() == other._key()
+
+    def __repr__(self) -> str:
+        return (f"Loaded(name={self.name!r}, module={self.module!r}, "
+                f"comp_ids={self.comp_ids!r}, args={self.args!r})")
 
 
 class Registry:

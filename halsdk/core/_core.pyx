@@ -26,10 +26,11 @@ cdef extern from "sys/prctl.h" nogil:
 import os
 import re
 import sys
-import traceback
 
 from halsdk.core import errors as _errors
-from halsdk.core import records as _records
+
+# halsdk.core.records (and traceback) are imported where they are used:
+# not at the start of every halcmd
 
 cdef extern from "hal_core.h" nogil:
     ctypedef uint32_t hoff_t
@@ -1415,6 +1416,7 @@ cdef list _records_of(int k, hal_snapshot_t *s):
     cdef uint32_t j
     cdef hal_snap_t *r
     cdef hal_snap_sub_t *sub
+    from halsdk.core import records as _records
     out = []
     for i in range(s.nrecs):
         r = &s.recs[i]
@@ -1775,6 +1777,7 @@ cdef void py_trampoline(void *arg, long period) noexcept nogil:
                 pf.reported = True
                 sys.stderr.write(f"halsdk: Python function '{pf.name}' "
                                  "raised (reported once):\n")
+                import traceback
                 traceback.print_exc()
 
 

@@ -15,7 +15,6 @@ Protocol: one JSON object per line each way.  Request
 
 from __future__ import annotations
 
-import json
 import os
 import socket
 import struct
@@ -146,6 +145,8 @@ class Server:
                 pass
 
     def _handle(self, client: socket.socket) -> None:
+        # json is imported on the first request, not by every halrun
+        import json
         creds = client.getsockopt(socket.SOL_SOCKET, socket.SO_PEERCRED,
                                   struct.calcsize("3i"))
         pid, uid, _gid = struct.unpack("3i", creds)
@@ -168,6 +169,7 @@ class Server:
             client.sendall(json.dumps(reply).encode() + b"\n")
 
     def _dispatch(self, line: bytes) -> dict[str, Any]:
+        import json
         try:
             req = json.loads(line)
             op = req["op"]
@@ -219,6 +221,7 @@ def request(shm: str, op: str, *args: Any, timeout: float = 60.0,
     ``timeout`` seconds, a garbled reply) raises
     :class:`~halsdk.errors.HostGoneError` naming the instance, never a
     bare ``OSError``."""
+    import json
     try:
         path = socket_path(shm)
     except OSError as exc:

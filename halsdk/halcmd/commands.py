@@ -9,12 +9,10 @@ from __future__ import annotations
 
 import os
 import re
-import shutil
-import subprocess
 import sys
 import time
 from collections.abc import Iterable
-from typing import Callable, Optional
+from typing import TYPE_CHECKING, Callable, Optional
 
 from halsdk import console
 from halsdk.compat import program_env
@@ -34,6 +32,12 @@ from halsdk.halcmd.save import Saver, status
 from halsdk.halcmd.show import Shower, type_name, value_text
 from halsdk.types import Direction, HalType, parse_type
 from halsdk.values import parse_word
+
+if TYPE_CHECKING:
+    import subprocess
+
+# shutil and subprocess are imported by loadusr, where they are used: a
+# halcmd that does not start programs starts faster
 
 Out = Callable[[str], None]
 
@@ -85,6 +89,7 @@ def hal_error(text: str, *messages: str) -> CommandError:
 def _program_path(prog: str) -> str:
     """A program for loadusr: on PATH, else a launcher that halcompile
     put in a HALSDK_PATH folder or the user component folder."""
+    import shutil
     if os.sep in prog or shutil.which(prog) is not None:
         return prog
     from halsdk.loader import search_path
@@ -188,6 +193,9 @@ class CommandRunner:
     def end_children(self, timeout: float = 5.0) -> None:
         """Programs started by ``loadusr`` and still running get SIGTERM,
         then SIGKILL if they have not ended after ``timeout`` seconds."""
+        if not self.children:
+            return
+        import subprocess
         for child in self.children:
             if child.poll() is None:
                 child.terminate()
@@ -436,6 +444,7 @@ class CommandRunner:
             # the compat hal/linuxcnc modules importable, as the
             # reference's halrun makes its own for the programs it starts
             # and ends with the host, however the host ends
+            import subprocess
             child = self.hal.spawn([_program_path(prog), *args[1:]],
                                    stdin=subprocess.DEVNULL,
                                    cwd=self.workdir, env=program_env())
