@@ -43,12 +43,14 @@ def ends_with_this_process(chained: Optional[Callable[[], None]] = None
     process, however it ends: ``PR_SET_PDEATHSIG``), and at once if that
     already happened; then ``chained`` runs.  Start from the main thread
     so that the thread lives as long as the process."""
+    import signal
     parent = os.getpid()
+    sigterm = int(signal.SIGTERM)
 
     def preexec() -> None:
-        _core.set_parent_death_signal(int(_signal.SIGTERM))
+        _core.set_parent_death_signal(sigterm)
         if os.getppid() != parent:      # the parent ended already
-            os.kill(os.getpid(), _signal.SIGTERM)
+            os.kill(os.getpid(), sigterm)
         if chained is not None:
             chained()
     return preexec
@@ -167,7 +169,6 @@ class Hal:
         elsewhere (an attached ``halcmd``, another thread of the host) a
         small ``halsdk-guard`` process waits on pidfds of the host and the
         program and ends with whichever ends first."""
-        import signal as _signal
         import subprocess
         import threading
         on_main = self._conn.host and \
