@@ -56,6 +56,42 @@ def ends_with_this_process(chained: Optional[Callable[[], None]] = None
     return preexec
 
 
+def _capture_items(what: str, names: Iterable[str]) -> list:
+    """The pins, signals or params ``names`` (NotFoundError naming the
+    first that is none of them)."""
+    items = []
+    for name in names:
+        obj = (_core.find("pin", name) or _core.find("signal", name)
+               or _core.find("param", name))
+        if obj is None:
+            raise NotFoundError(f"{what}: no pin, signal or param named "
+                                f"'{name}'")
+        items.append(obj)
+    return items
+
+
+def _capture_comp(comp: str, items: list, depth: int, thread: str,
+                  position: int) -> tuple[int, Any]:
+    """A realtime component ``comp`` whose function (added to ``thread``
+    at ``position``) copies ``items`` into its stream of ``depth``
+    records each cycle; ``(component id, stream)``.  Nothing is left
+    when it fails."""
+    _core.set_loading_rt(True)
+    try:
+        cid = _core.comp_new(comp, _core.COMP_RT)
+    finally:
+        _core.set_loading_rt(False)
+    try:
+        uses_fp = any(o.type == _core.FLOAT for o in items)
+        stream = _core.capture_new(cid, comp, comp, items, depth, uses_fp)
+        _core.comp_ready(cid, True)
+        _core.addf(comp, thread, position)
+    except BaseException:
+        _core.comp_exit(cid)
+        raise
+    return cid, stream
+
+
 def is_halcmd_comp(name: str, pid: int) -> bool:
     """Whether a component is the ``halcmd<pid>`` of a halcmd session
     (``unload all`` and ``unloadusr all`` leave those alone)."""
@@ -772,14 +808,7 @@ class Hal:
         if not isinstance(cycles, int) or cycles < 1:
             raise InvalidError(f"capture: cycles={cycles!r} is not a "
                                "positive integer")
-        items = []
-        for name in names:
-            obj = (_core.find("pin", name) or _core.find("signal", name)
-                   or _core.find("param", name))
-            if obj is None:
-                raise NotFoundError(f"capture: no pin, signal or param "
-                                    f"named '{name}'")
-            items.append(obj)
+        items = _capture_items("capture", names)
         threads = _core.items("thread")
         if thread is None:
             if not threads:
@@ -789,17 +818,8 @@ class Hal:
             th = self.thread(thread)
         Hal._captures += 1
         comp = f"__capture{os.getpid()}.{Hal._captures}"
-        _core.set_loading_rt(True)
+        cid, stream = _capture_comp(comp, items, cycles, th.name, position)
         try:
-            cid = _core.comp_new(comp, _core.COMP_RT)
-        finally:
-            _core.set_loading_rt(False)
-        try:
-            uses_fp = any(o.type == _core.FLOAT for o in items)
-            stream = _core.capture_new(cid, comp, comp, items, cycles,
-                                       uses_fp)
-            _core.comp_ready(cid, True)
-            _core.addf(comp, th.name, position)
             if _core.info()["threads_running"]:
                 limit = timeout if timeout is not None else \
                     5.0 + 2.0 * cycles * th.period * 1e-9
@@ -870,30 +890,11 @@ class Hal:
             raise InvalidError(f"recorder: bad pid {pid!r}")
         with self._conn.lock:
             self._sweep_recorders()
-            items = []
-            for name in names:
-                obj = (_core.find("pin", name) or _core.find("signal", name)
-                       or _core.find("param", name))
-                if obj is None:
-                    raise NotFoundError(f"recorder: no pin, signal or param "
-                                        f"named '{name}'")
-                items.append(obj)
+            items = _capture_items("recorder", names)
             th = self.thread(thread)
             Hal._captures += 1
             comp = f"{Hal.RECORDER_PREFIX}{pid}.{Hal._captures}"
-            _core.set_loading_rt(True)
-            try:
-                cid = _core.comp_new(comp, _core.COMP_RT)
-            finally:
-                _core.set_loading_rt(False)
-            try:
-                uses_fp = any(o.type == _core.FLOAT for o in items)
-                _core.capture_new(cid, comp, comp, items, depth - 1, uses_fp)
-                _core.comp_ready(cid, True)
-                _core.addf(comp, th.name, -1)
-            except BaseException:
-                _core.comp_exit(cid)
-                raise
+            _capture_comp(comp, items, depth - 1, th.name, -1)
             return comp
 
     def recorder_delete(self, name: str) -> None:

@@ -137,7 +137,8 @@ def _machine(hal) -> None:
 
 
 def _recorders(hal) -> list[str]:
-    return [c.name for c in hal.components()
+    # a snapshot: the server may remove a recorder while we look
+    return [c.name for c in hal.snapshot("component")
             if c.name.startswith(hal.RECORDER_PREFIX)]
 
 
