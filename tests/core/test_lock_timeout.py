@@ -191,6 +191,12 @@ def test_lock_timeout_setting(hal, monkeypatch, tmp_path):
 
 
 def test_the_holder_is_recorded_and_cleared(hal):
-    assert _core.lock_holder() == 0
-    assert hal.info()["lock_holder"] == 0
+    # the host's own watch of userspace components takes the lock now and
+    # then: one of a few looks finds it free
+    for _ in range(100):
+        if _core.lock_holder() == 0 and hal.info()["lock_holder"] == 0:
+            break
+        time.sleep(0.01)
+    else:
+        pytest.fail(f"the lock stays held by pid {_core.lock_holder()}")
     assert hal.info()["abi"] >= 4

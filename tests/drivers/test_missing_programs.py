@@ -40,10 +40,13 @@ def run_without_mosquitto(tmp_path: Path, ci: str | None
     env.pop("CI", None)
     if ci is not None:
         env["CI"] = ci
+    # run from tmp_path: "python -m" puts its folder first on sys.path,
+    # and the checkout's unbuilt halsdk must not hide the installed one
     return subprocess.run(
         [sys.executable, "-m", "pytest", "-p", "no_mosquitto", "-rs",
-         "-p", "no:cacheprovider", *TESTS],
-        cwd=REPO, env=env, capture_output=True, text=True, timeout=600)
+         "-p", "no:cacheprovider", "-c", str(REPO / "pyproject.toml"),
+         "--rootdir", str(REPO), *[str(REPO / t) for t in TESTS]],
+        cwd=tmp_path, env=env, capture_output=True, text=True, timeout=600)
 
 
 def test_the_tests_named_here_exist() -> None:

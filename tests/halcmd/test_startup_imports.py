@@ -53,10 +53,28 @@ def _run(args: list[str], cwd: Path) -> tuple[str, int, set[str]]:
     return proc.stdout, status, set(modules)
 
 
+def _at_start() -> set[str]:
+    """What this interpreter imports before running anything (its
+    ``site``: a ``.pth`` file of another package may import tempfile or
+    shutil already); those are not the programs' doing."""
+    proc = subprocess.run(
+        [sys.executable, "-c", "import sys; print(sorted(sys.modules))"],
+        capture_output=True, text=True, timeout=60, check=True,
+        stdin=subprocess.DEVNULL)
+    return set(ast.literal_eval(proc.stdout))
+
+
+_BARE: set[str] = set()
+
+
 def _loaded(modules: set[str], names: tuple[str, ...]) -> list[str]:
+    """Which of ``names`` (or their submodules) the program imported,
+    beyond what the bare interpreter had imported already."""
+    if not _BARE:
+        _BARE.update(_at_start())
+    mine = modules - _BARE
     return sorted(n for n in names
-                  if n in modules or any(m.startswith(n + ".")
-                                         for m in modules))
+                  if n in mine or any(m.startswith(n + ".") for m in mine))
 
 
 def test_import_of_the_cli_is_light(tmp_path):

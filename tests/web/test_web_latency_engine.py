@@ -9,6 +9,7 @@ import json
 import os
 import subprocess
 import sys
+import tempfile
 import time
 
 import pytest
@@ -285,9 +286,11 @@ with Hal(create=False) as hal:
 
 
 def _attached() -> dict:
+    # cwd: not the checkout, whose unbuilt halsdk "python -c" would find
+    # before the installed one
     proc = subprocess.run([sys.executable, "-c", ATTACHED],
                           capture_output=True, text=True, timeout=120,
-                          env=dict(os.environ))
+                          env=dict(os.environ), cwd=tempfile.gettempdir())
     assert proc.returncode == 0, proc.stderr
     return json.loads(proc.stdout)
 

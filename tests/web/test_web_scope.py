@@ -183,7 +183,7 @@ def test_a_pin_linked_later_is_recorded_from_its_signal(hal):
     hal.recorder_delete(name)
 
 
-def test_the_recorder_of_a_killed_process_is_swept(hal):
+def test_the_recorder_of_a_killed_process_is_swept(hal, tmp_path):
     """An attached process that records and is killed leaves its recorder;
     the next recorder made removes it."""
     _machine(hal)
@@ -195,7 +195,7 @@ def test_the_recorder_of_a_killed_process_is_swept(hal):
                 "time.sleep(60)\n")
         proc = subprocess.Popen([sys.executable, "-c", code],
                                 stdout=subprocess.PIPE, text=True,
-                                env=dict(os.environ))
+                                env=dict(os.environ), cwd=tmp_path)
         assert proc.stdout is not None
         orphan = proc.stdout.readline().strip()
         assert orphan in _recorders(hal)
