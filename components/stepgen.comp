@@ -166,7 +166,8 @@ static int pat_len[16] = { 0, 0, 4, 3, 6, 4, 4, 4, 4, 8, 8, 5, 5, 10, 10, 0 };
 static int pat_pins[16] = { 2, 2, 2, 3, 3, 4, 4, 4, 4, 4, 4, 5, 5, 5, 5, 0 };
 
 typedef struct {
-    /* used by make-pulses (fast thread) */
+    /* used by make-pulses (fast thread); what every run reads and writes
+       comes first, in the channel's first two cache lines */
     long long acc;          /* position in steps << FRAC, plus half a step */
     long add;               /* added to acc each base period */
     long add_goal;          /* add value asked for by update-freq */
@@ -174,16 +175,17 @@ typedef struct {
     unsigned long t_pulse;  /* ns until the step pulse may end */
     unsigned long t_dir;    /* ns until the direction output may change */
     unsigned long t_rev;    /* ns until motion may restart the other way */
+    hal_bit_t *en;
     int dir;                /* +1 forward, -1 reverse */
     int held;               /* waiting for t_rev before reversing */
     int step_on, dir_on;    /* step type 0: what step and dir show */
     int type;
+    hal_s32_t rawcount;
+    hal_bit_t *out[5];      /* step/dir, up/down or the phases */
     int state;              /* index in the pattern (types 2 and up) */
     int nstates;
+    int npins;              /* phase pins (types 2 and up) */
     const unsigned char *pat;
-    hal_bit_t *out[5];      /* step/dir, up/down or the phases */
-    hal_bit_t *en;
-    hal_s32_t rawcount;
     hal_u32_t steplen, stepspace, dirsetup, dirhold;  /* dirhold is dirdelay */
     unsigned long hold_ns;  /* dirhold as used, never 0 for types 1 and up */
     /* used by update-freq and capture-position (slow thread) */
@@ -211,23 +213,42 @@ static void tick(unsigned long *t, unsigned long ns)
     *t = *t > ns ? *t - ns : 0;
 }
 
-/* the phases show the pattern word of the present state */
+/* the phases show the pattern word of the present state (every run: a
+   pin linked to a new signal shows the state at once) */
 static void show_state(chan_t *c)
 {
-    unsigned char w = c->pat[c->state];
-    int k;
+    unsigned w = c->pat[c->state];
 
-    for (k = 0; k < pat_pins[c->type]; k++)
-        *c->out[k] = (w >> k) & 1;
+    switch (c->npins) {
+    case 5:
+        *c->out[4] = (w >> 4) & 1;
+        /* fall through */
+    case 4:
+        *c->out[3] = (w >> 3) & 1;
+        /* fall through */
+    case 3:
+        *c->out[2] = (w >> 2) & 1;
+        /* fall through */
+    case 2:
+        *c->out[1] = (w >> 1) & 1;
+        /* fall through */
+    case 1:
+        *c->out[0] = w & 1;
+        break;
+    default:
+        break;
+    }
 }
 
 static void make_pulses(void *arg, long period)
 {
     chan_t *c = arg;
-    int n;
+    /* the outputs are bool stores, which may alias anything: a count
+       read in the loop would be read again on every channel */
+    chan_t *const end = c + nchan;
 
     base_ns = period;
-    for (n = 0; n < nchan; n++, c++) {
+    for (; c < end; c++) {
         long add;
         long long acc;
         int stepped;
@@ -272,8 +293,9 @@ static void make_pulses(void *arg, long period)
             c->add = add;
         }
         add = c->add;
-        /* zero counts as forward */
-        if ((add >= 0) != (c->dir > 0)) {
+        /* zero counts as forward: the signs of add and dir (+1 or -1)
+           differ when the xor of the two is negative */
+        if ((add ^ (long)c->dir) < 0) {
             if (c->t_rev != 0)
                 c->held = 1;
             else
@@ -282,9 +304,11 @@ static void make_pulses(void *arg, long period)
         if (c->type == 0) {
             /* the outputs are written when they change: fewer stores to
                shared memory in the common case of nothing to do */
-            if (c->t_dir == 0 && add != 0 && (add < 0) != c->dir_on)
+            /* the likely false test first: the direction shown is right
+               and no pulse is up */
+            if ((add < 0) != c->dir_on && add != 0 && c->t_dir == 0)
                 *c->out[1] = c->dir_on = add < 0;
-            if (c->t_pulse == 0 && c->step_on)
+            if (c->step_on && c->t_pulse == 0)
                 *c->out[0] = c->step_on = 0;
         } else if (c->type == 1) {
             if (c->t_pulse == 0)
@@ -553,6 +577,7 @@ static int make_channel(int n, chan_t *c)
     c->dir = 1;
     c->pat = pats[t];
     c->nstates = pat_len[t];
+    c->npins = pat_pins[t];
     return 0;
 }
 
