@@ -110,10 +110,18 @@ def test_a_stopped_run_ends_cleanly(tmp_path, signame):
 
     (tmp_path / "test_stoppable.py").write_text(STOPPABLE_PROJECT)
     env = {k: v for k, v in os.environ.items() if k != "HALSDK_INSTANCE"}
+    sig = getattr(signal, signame)
+
+    def default_disposition() -> None:
+        # an ignored SIGHUP (this run started under nohup) is inherited,
+        # and the plugin rightly leaves an ignored signal alone
+        signal.signal(sig, signal.SIG_DFL)
+
     proc = subprocess.Popen(
         [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider",
          "test_stoppable.py"], cwd=tmp_path, env=env,
-        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+        preexec_fn=default_disposition)
     started = tmp_path / "started"
     deadline = time.monotonic() + 60
     while not started.exists() and proc.poll() is None \
