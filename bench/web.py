@@ -16,7 +16,7 @@ lost (server)      what the server counted: gaps in the stream's sample
                    numbers (its ring was full)
 overruns           records the realtime function found no room for
 server CPU         user + system time of the ``halsdk web`` process over
-                   the measured time, in % of one core (/proc/PID/stat)
+                   the measured time, in % of one core (the process CPU clock)
 =================  ======================================================
 
 It then runs the Show page's measurement (bench/web_show.py: 10,000
@@ -43,6 +43,7 @@ from websockets.sync.client import connect
 import halsdk
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from thread_overhead import process_cpu  # noqa: E402
 
 TOKEN = "bench-web-token-0123456789"
 PINS = ["siggen.0.sine", "siggen.0.cosine", "siggen.0.square",
@@ -63,14 +64,6 @@ def free_port() -> int:
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
         return int(s.getsockname()[1])
-
-
-def cpu_seconds(pid: int) -> float:
-    """User + system time of a process."""
-    with open(f"/proc/{pid}/stat", "rb") as f:
-        fields = f.read().rsplit(b")", 1)[1].split()
-    ticks = os.sysconf("SC_CLK_TCK")
-    return (int(fields[11]) + int(fields[12])) / ticks
 
 
 def run(seconds: float, channels: int) -> dict:
@@ -115,7 +108,7 @@ def run(seconds: float, channels: int) -> dict:
             received = lost = 0
             expected = None
             status: dict = {}
-            cpu0 = cpu_seconds(server.pid)
+            cpu0 = process_cpu(server.pid)
             t0 = time.monotonic()
             while time.monotonic() - t0 < seconds:
                 msg = json.loads(ws.recv(timeout=10))
@@ -130,7 +123,7 @@ def run(seconds: float, channels: int) -> dict:
                 expected = roll["start"] + n
                 received += n
             elapsed = time.monotonic() - t0
-            cpu = cpu_seconds(server.pid) - cpu0
+            cpu = process_cpu(server.pid) - cpu0
         return {"seconds": elapsed, "channels": channels,
                 "received": received, "rate": received / elapsed,
                 "lost_client": lost, "lost_server": status.get("lost", 0),

@@ -37,14 +37,10 @@ from typing import Any
 
 import halsdk
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from thread_overhead import process_cpu  # noqa: E402
+
 TOKEN = "bench-web-token"
-
-
-def _cpu_seconds(pid: int) -> float:
-    with open(f"/proc/{pid}/stat") as f:
-        fields = f.read().rpartition(")")[2].split()
-    ticks = os.sysconf("SC_CLK_TCK")
-    return (int(fields[11]) + int(fields[12])) / ticks
 
 
 def _serve(instance: str) -> tuple[subprocess.Popen, str]:
@@ -119,9 +115,9 @@ def measure(pins: int, seconds: float, updates: int) -> dict[str, Any]:
                 # CPU of the server with 50 pins on the screen
                 page.fill("#search", "and2.1?.")
                 page.wait_for_timeout(500)
-                c0, w0 = _cpu_seconds(proc.pid), time.monotonic()
+                c0, w0 = process_cpu(proc.pid), time.monotonic()
                 time.sleep(seconds)
-                c1, w1 = _cpu_seconds(proc.pid), time.monotonic()
+                c1, w1 = process_cpu(proc.pid), time.monotonic()
                 figures["server_cpu_pct"] = 100 * (c1 - c0) / (w1 - w0)
                 browser.close()
         finally:
