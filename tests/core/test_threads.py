@@ -206,6 +206,59 @@ def test_realtime_threads_run_and_stop(hal):
     assert not hal.info()["simulated_clock"]
 
 
+def _run_with_a_stall(hal, stall_s: float, at: int, total: int):
+    """Run a 1 ms thread whose function sleeps stall_s in its call number
+    `at`; return the call times (ns) and the thread's overruns."""
+    calls: list[int] = []
+
+    def fn(period: int) -> None:
+        calls.append(time.monotonic_ns())
+        if len(calls) == at:
+            time.sleep(stall_s)
+
+    hal.newthread("servo", 1_000_000)
+    hal.add_python_function("stall.fn", fn, "servo")
+    hal.start()
+    try:
+        deadline = time.monotonic() + 30
+        while len(calls) < total and time.monotonic() < deadline:
+            time.sleep(0.01)
+    finally:
+        hal.stop()
+    assert len(calls) >= total
+    return calls, hal.thread("servo").overruns
+
+
+def _lag(calls: list[int], k: int) -> float:
+    """How many periods call k came after it was due (call 0 on time)."""
+    return (calls[k] - calls[0]) / 1e6 - k
+
+
+def test_missed_cycles_run_back_to_back(hal):
+    """A cycle that runs long costs no cycles: the ones that fell due
+    meanwhile run at once, back to back, and count as overruns (a
+    stepgen then makes every step it was asked for)."""
+    calls, overruns = _run_with_a_stall(hal, 0.03, at=20, total=150)
+    # right after the 30 ms stall the missed cycles run back to back
+    burst = [(calls[k + 1] - calls[k]) / 1e6 for k in range(20, 40)]
+    assert sorted(burst)[10] < 0.5
+    # then the thread is on schedule again: no cycle was lost (a lost
+    # cycle would leave every later call about a period later than due)
+    assert min(_lag(calls, k) for k in range(100, len(calls))) < 5
+    assert overruns >= 20
+
+
+def test_a_long_stall_drops_its_cycles(hal):
+    """Past 100 ms behind (a stopped process, a debugger) the missed
+    cycles are dropped, not run in a burst; they count as overruns."""
+    calls, overruns = _run_with_a_stall(hal, 0.25, at=10, total=60)
+    after = calls[10]
+    burst = sum(1 for t in calls[11:] if t - after < 10_000_000)
+    assert burst < 50                   # not the 250 missed cycles
+    assert min(_lag(calls, k) for k in range(11, len(calls))) > 200
+    assert overruns >= 240
+
+
 def test_stepping_refused_while_running(hal):
     hal.newthread("servo", 1_000_000)
     hal.start()
