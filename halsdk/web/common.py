@@ -5,6 +5,7 @@ a change's JSON body with its origin check."""
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import json
 from concurrent.futures import ThreadPoolExecutor
 from functools import partial
@@ -58,6 +59,15 @@ class Workbench:
     async def call(self, fn: Callable[..., T], *args: Any) -> T:
         loop = asyncio.get_running_loop()
         return await loop.run_in_executor(self._pool, partial(fn, *args))
+
+    def submit(self, fn: Callable[..., Any], *args: Any) -> None:
+        """Run ``fn(*args)`` on the worker without waiting for it: the
+        clean-up of a handler that may itself be cancelled (a test
+        client or a server shutting down cancels it, and every await
+        in its ``finally`` is then cancelled too). Once the workbench
+        is closed, :meth:`close` cleans up instead."""
+        with contextlib.suppress(RuntimeError):     # the pool is shut down
+            self._pool.submit(fn, *args)
 
     def close(self) -> None:
         for page in list(self.pages.values()):

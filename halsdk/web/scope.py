@@ -493,8 +493,7 @@ def routes(bench: Workbench) -> list[BaseRoute]:
             with contextlib.suppress(BaseException):
                 await task
             page.sessions.pop(session.id, None)
-            with contextlib.suppress(BaseException):
-                await bench.call(session.stop)
+            bench.submit(session.stop)
 
     return [
         Route("/api/scope/sources", get_sources),
