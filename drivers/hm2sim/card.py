@@ -150,10 +150,13 @@ class Card:
         width_mask = (1 << self.port_width) - 1
         # the field levels of the pins, a bit mask per port (pull-ups: 1)
         self.field = [width_mask] * nports
-        # pins whose level a module makes: (pin, port, bit)
-        self._module_pins = [
-            (i, *divmod(i, self.port_width))
-            for i, d in enumerate(p.pins) if d.sec_tag in MODELLED]
+        # per port, the pins whose level a module makes: (pin, bit)
+        self._module_pins: list[list[tuple[int, int]]] = [
+            [] for _ in range(nports)]
+        for i, d in enumerate(p.pins):
+            if d.sec_tag in MODELLED:
+                port, bit = divmod(i, self.port_width)
+                self._module_pins[port].append((i, bit))
         self.stepgens = [StepGen() for _ in range(p.instances(GTAG_STEPGEN))]
         self.encoders = [Encoder() for _ in range(p.instances(GTAG_ENCODER))]
         npwm = p.instances(GTAG_PWMGEN)
@@ -309,9 +312,7 @@ class Card:
         """The levels of a port's pins as the outside world sees them."""
         field = self.field[port]
         module = 0
-        for pin, p, bit in self._module_pins:
-            if p != port:
-                continue
+        for pin, bit in self._module_pins[port]:
             enc = self._encoder_input(pin)
             if enc is not None:
                 field = field | (1 << bit) if enc else field & ~(1 << bit)
