@@ -1,0 +1,130 @@
+#!/bin/bash
+# Regenerate the reference's golden listings of the simulated Mesa cards.
+#
+#   sudo tests/data/hm2/regen.sh [BOARD...]      (default: every profile)
+#
+# For each board profile of hm2-sim (drivers/hm2sim/profiles.py) this runs
+# the reference's hostmot2 + hm2_eth (LinuxCNC 2.9, ../shared/tools/reference)
+# against `hm2-sim --board BOARD` and writes tests/data/hm2/BOARD/:
+#   load.hal        the HAL file (loadrt hostmot2, hm2_eth, a servo thread,
+#                   show pin/param/funct)
+#   load.txt        what the reference printed (its stdout and stderr)
+#   show-pin.txt, show-param.txt, show-funct.txt   the listings
+#   packets.txt     the LBP16 conversation, decoded: the load, the first
+#                   servo cycles and the unload (hm2-sim --log; the time
+#                   in brackets is how long the card took to reply)
+#
+# Why a network namespace: hm2_eth reads the card's MAC address and sets a
+# static ARP entry for the card (SIOCSARP), which the loopback interface
+# refuses (EINVAL).  So the card lives at 10.96.7.2 in the network
+# namespace hm2sim, behind a veth pair (10.96.7.1 on this side) whose far
+# end carries the MAC the profile reports.  Needs root (ip netns, ip link);
+# hm2_eth also adds an empty iptables chain hm2-eth-rules-output and a jump
+# to it from OUTPUT, and removes its ARP entry when it unloads.
+#
+# Environment: HM2SIM_PYTHON a Python with halsdk installed (default
+# python3), PERIOD the servo period in ns (default 1000000), KEEP=1 keeps
+# the work folder (with the whole packet log), REFERENCE the reference
+# wrapper (default ../shared/tools/reference beside the checkout).
+#
+# The names, types and directions of the listings are the golden part;
+# some values depend on timing (watchdog.has_bit when the non-realtime
+# reference thread was late by more than the watchdog's 5 ms, the packet
+# error counters, encoder timestamps, read-request.time).
+set -euo pipefail
+here=$(cd "$(dirname "$0")" && pwd)
+root=$(cd "$here/../../.." && pwd)
+python=${HM2SIM_PYTHON:-python3}
+ns=hm2sim
+host_ip=10.96.7.1
+card_ip=10.96.7.2
+boards=("$@")
+[ ${#boards[@]} -gt 0 ] || boards=(7i96s 7i92)
+export PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin
+
+if ! ip netns list | grep -qw "$ns"; then
+    ip netns add "$ns"
+    ip link add hm2sim0 type veth peer name hm2sim1 netns "$ns"
+    ip addr add "$host_ip/24" dev hm2sim0
+    ip link set hm2sim0 up
+    ip -n "$ns" addr add "$card_ip/24" dev hm2sim1
+    ip -n "$ns" link set hm2sim1 up
+    ip -n "$ns" link set lo up
+fi
+
+for board in "${boards[@]}"; do
+    out="$here/$board"
+    mkdir -p "$out"
+    rm -f "$out"/*.txt
+    mac=$(cd /tmp && "$python" -c "from halsdk.drivers.hm2sim import profile; print(profile('$board').mac.hex(':'))")
+    config=$(cd /tmp && "$python" -c "from halsdk.drivers.hm2sim import profile; print(profile('$board').config)")
+    ip -n "$ns" link set hm2sim1 address "$mac"
+    ip neigh flush dev hm2sim0
+    work=$(mktemp -d /tmp/hm2sim-regen.XXXXXX)
+    chmod 755 "$work"
+    name="hm2_$board.0"
+    cat > "$out/load.hal" <<HAL
+# hostmot2 + hm2_eth against hm2-sim --board $board (tests/data/hm2/regen.sh)
+loadrt hostmot2
+loadrt hm2_eth board_ip=$card_ip config="$config"
+loadrt threads name1=servo-thread period1=${PERIOD:-1000000}
+addf $name.read servo-thread
+addf $name.write servo-thread
+start
+loadusr -w sleep 0.2
+stop
+show pin
+show param
+show funct
+HAL
+    cp "$out/load.hal" "$work/"
+    # hm2_eth gives the first replies after loading only a few hundred
+    # microseconds (a real card answers in less): the card runs with
+    # realtime scheduling, and a load that timed out on a busy machine
+    # is tried again
+    for attempt in 1 2 3 4 5; do
+        rm -f "$work/packets.txt" "$work/sim.txt"
+        (cd /tmp && exec ip netns exec "$ns" chrt -f 20 "$python" \
+            -m halsdk.drivers.hm2sim --board "$board" --address "$card_ip" \
+            --log "$work/packets.txt" > "$work/sim.txt" 2>&1) &
+        sim=$!
+        for _ in $(seq 50); do
+            grep -q "on UDP" "$work/sim.txt" 2>/dev/null && break
+            sleep 0.1
+        done
+        set +e
+        (cd "$work" && flock /tmp/halsdk-reference.lock \
+            "${REFERENCE:-$root/../shared/tools/reference}" halrun -f load.hal \
+            > halrun.txt 2>&1)
+        rc=$?
+        set -e
+        kill "$sim"; wait "$sim" 2>/dev/null || true
+        if [ $rc -eq 0 ] && grep -q ": registered" "$work/halrun.txt"; then
+            break
+        fi
+        echo "$board: attempt $attempt failed:" \
+            "$(grep -m1 -i 'error' "$work/halrun.txt" || true)"
+        sleep 2
+    done
+    # the listings, split at their headings; the rest is what the load printed
+    awk -v dir="$out" '
+        /^Component Pins:/      { f = dir "/show-pin.txt" }
+        /^Parameters:/          { f = dir "/show-param.txt" }
+        /^Exported Functions:/  { f = dir "/show-funct.txt" }
+        f && /^$/               { print > f; f = ""; next }
+        f { print > f; next }
+        { print > (dir "/load.txt") }' "$work/halrun.txt"
+    # the load and the first servo cycles, then the unload
+    total=$(wc -l < "$work/packets.txt")
+    {
+        head -n 600 "$work/packets.txt"
+        if [ "$total" -gt 620 ]; then
+            echo "... ($((total - 620)) lines of later servo cycles left out) ..."
+            tail -n 20 "$work/packets.txt"
+        else
+            tail -n +601 "$work/packets.txt"
+        fi
+    } > "$out/packets.txt"
+    echo "$board: reference exit status $rc (attempt $attempt)"
+    if [ -n "${KEEP:-}" ]; then echo "kept $work"; else rm -rf "$work"; fi
+done
