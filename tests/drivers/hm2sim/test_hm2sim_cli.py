@@ -36,10 +36,15 @@ def test_help(tmp_path: Path) -> None:
         assert word in proc.stdout
 
 
-@pytest.mark.skipif(shutil.which("hm2-sim") is None,
-                    reason="the console script is not installed")
+SCRIPT = shutil.which("hm2-sim", path=str(Path(sys.executable).parent)) \
+    or shutil.which("hm2-sim")
+
+
+@pytest.mark.skipif(SCRIPT is None, reason="the console script is not "
+                    "installed (pip install -e . makes it)")
 def test_console_script_help(tmp_path: Path) -> None:
-    proc = subprocess.run(["hm2-sim", "--help"], cwd=tmp_path,
+    assert SCRIPT is not None
+    proc = subprocess.run([SCRIPT, "--help"], cwd=tmp_path,
                           capture_output=True, text=True, timeout=30)
     assert proc.returncode == 0 and "--board" in proc.stdout
 
