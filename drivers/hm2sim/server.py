@@ -136,6 +136,7 @@ class Hm2Sim:
         self.realtime = realtime
         self.faults = Faults(seed)
         self._lock = threading.RLock()
+        self._arrived = threading.Condition(self._lock)
         self._sock: Optional[socket.socket] = None
         self._thread: Optional[threading.Thread] = None
         self._stop = threading.Event()
@@ -230,7 +231,13 @@ class Hm2Sim:
                     continue
                 except OSError:
                     continue
-                self._handle(sock, packet, peer)
+                try:
+                    self._handle(sock, packet, peer)
+                except Exception as exc:        # noqa: BLE001
+                    # a bug in the model must not take the card down
+                    # silently: keep serving, keep the first error
+                    if self.error is None:
+                        self.error = exc
                 if self._pending:
                     self._send_due(sock)
         except BaseException as exc:        # noqa: BLE001 - kept for stop()
@@ -266,6 +273,7 @@ class Hm2Sim:
         with self._lock:
             counts = self._counts
             counts["requests"] += 1
+            self._arrived.notify_all()
             if self.faults.away:
                 counts["ignored"] += 1
                 note = "(away)"
@@ -357,6 +365,19 @@ class Hm2Sim:
                 self.card.reset()
                 self._t0 = time.monotonic()
             self.faults.away = False
+
+    @property
+    def requests(self) -> int:
+        """The number of datagrams received so far."""
+        return self._counts["requests"]
+
+    def wait_requests(self, count: int, timeout: float = 1.0) -> bool:
+        """Wait until ``count`` datagrams have been received in all (see
+        :attr:`requests`), at most ``timeout`` seconds; whether they
+        were."""
+        with self._arrived:
+            return self._arrived.wait_for(
+                lambda: self._counts["requests"] >= count, timeout)
 
     @property
     def stats(self) -> Stats:

@@ -220,3 +220,23 @@ def test_packet_log(tmp_path: Path) -> None:
     assert "<- 81420001" in text
     assert "read hm2 0x0100 32bit x1 inc" in text
     assert "-> fecaaa55" in text
+
+
+def test_wait_requests(sim: Hm2Sim, client: Client) -> None:
+    assert sim.requests == 0
+    assert not sim.wait_requests(1, timeout=0.05)
+    client.sock.send(lbp16.encode([lbp16.write(0, 0x0200, [7])]))
+    assert sim.wait_requests(1, timeout=5.0)
+    assert sim.requests == 1
+    assert sim.leds == 7                        # executed when counted
+
+
+def test_a_model_error_does_not_stop_the_card(sim: Hm2Sim, client: Client,
+                                              monkeypatch) -> None:
+    def broken(commands):
+        raise RuntimeError("model bug")
+    monkeypatch.setattr(sim.card, "execute", broken)
+    assert client.ask(timeout=QUIET) is None
+    monkeypatch.undo()
+    assert client.ask() == COOKIE_REPLY
+    assert isinstance(sim.error, RuntimeError) and sim.running
