@@ -47,7 +47,9 @@ ENC_INPUT_B = 1 << 2
 ENC_INPUT_INDEX = 1 << 3
 ENC_CONTROL_MASK = 0x7FF0
 
-# the memory space descriptions of the info area (bit 13 of a command)
+# the memory space descriptions of the info area (bit 13 of a command):
+# name, sizes and ranges words as LBP16 describes them; the values are
+# plausible, not a real card's (hm2_eth does not read them)
 _SPACE_INFO = {
     lbp16.SPACE_HM2: (b"HostMot2", 0x0201, 0x1F10),
     lbp16.SPACE_EEPROM: (b"EEPROM\0\0", 0x8202, 0x0F0F),
@@ -182,36 +184,38 @@ class Card:
         if seconds <= self.time:
             return
         ticks = int(seconds * self.clock)
-        delta = ticks - self.ticks
         self.time = seconds
-        if delta <= 0:
+        if ticks <= self.ticks:
             return
         wd = self.watchdog
         if not wd.bitten and not wd.timeout & WATCHDOG_DISABLED:
             deadline = wd.pet_at + wd.timeout
             if ticks > deadline:
                 # run up to the bite, then bite
-                self._run(deadline - self.ticks, seconds)
-                self.ticks = deadline
+                self._run_to(deadline)
                 self.bite()
-                delta = ticks - self.ticks
-        self._run(delta, seconds)
-        self.ticks = ticks
+        self._run_to(ticks)
 
-    def _run(self, delta: int, seconds: float) -> None:
+    def _run_to(self, ticks: int) -> None:
+        delta = ticks - self.ticks
         if delta <= 0:
             return
         for sg in self.stepgens:
             if sg.rate:
                 sg.units += sg.rate * delta
                 sg.direction = sg.rate < 0
+        # the encoders move at the end of the interval (their timestamps)
+        self.ticks = ticks
         for n, enc in enumerate(self.encoders):
             if enc.velocity:
                 enc.carry += enc.velocity * delta / self.clock
                 whole = int(enc.carry)
                 if whole:
                     enc.carry -= whole
-                    self._move_encoder(n, enc.position + whole)
+                    # the last count came |carry| counts ago
+                    ago = int(abs(enc.carry / enc.velocity) * self.clock)
+                    self._move_encoder(n, enc.position + whole,
+                                       max(ticks - ago, ticks - delta))
         for c in self.couplings:
             steps = self.stepgens[c.stepgen].steps - c.origin_steps
             self._move_encoder(c.encoder, c.origin_counts
@@ -229,11 +233,16 @@ class Card:
         self.pwm_enable = 0
 
     # --- encoders ----------------------------------------------------
-    def _timestamp(self) -> int:
+    def _timestamp(self, ticks: Optional[int] = None) -> int:
         div = self.misc.values.get(ENCODER_BASE + 2 * REG_STRIDE, 0) & 0xFFFF
-        return (self.ticks // (div + 2)) & 0xFFFF
+        if ticks is None:
+            ticks = self.ticks
+        return (ticks // (div + 2)) & 0xFFFF
 
-    def _move_encoder(self, n: int, position: int) -> None:
+    def _move_encoder(self, n: int, position: int,
+                      at: Optional[int] = None) -> None:
+        """Move encoder ``n``; ``at``: the clock tick of its last count
+        (default now)."""
         enc = self.encoders[n]
         old = enc.position
         if position == old:
@@ -251,7 +260,7 @@ class Card:
                 enc.position = k * p
                 self._index(n)
         enc.position = position
-        enc.change_ts = self._timestamp()
+        enc.change_ts = self._timestamp(at)
 
     def _index(self, n: int) -> None:
         enc = self.encoders[n]

@@ -258,3 +258,16 @@ def test_reset_is_power_on(card: Card) -> None:
     card.reset()
     assert card.stepgens[0].steps == 0 and card.stepgens[0].rate == 0
     assert card.pin_level(0)
+
+
+def test_encoder_timestamp_of_the_last_count(card: Card) -> None:
+    wr(card, 0x3200, 98)                        # timestamps at 1 MHz
+    card.encoders[0].velocity = 1000.0          # counts per second
+    card.advance_to(0.0105)
+    value = rd(card, ENC_COUNT)
+    assert value & 0xFFFF == 10
+    # the last count came at 10 ms; the timestamp counter is at 10.5 ms
+    assert value >> 16 == 10_000
+    assert rd(card, 0x3300) == 10_500
+    card.set_encoder(0, 20)                     # set now: stamped now
+    assert rd(card, ENC_COUNT) >> 16 == 10_500
