@@ -6,6 +6,7 @@ import errno
 import heapq
 import random
 import socket
+import struct
 import threading
 import time
 from dataclasses import dataclass
@@ -21,6 +22,9 @@ from .profiles import Profile, profile
 _POLL = 0.05
 #: the longest the server thread may take to stop
 STOP_TIMEOUT = 5.0
+#: the kernel's receive timestamp of a datagram (Linux: SO_TIMESTAMPNS)
+_SO_TIMESTAMPNS = getattr(socket, "SO_TIMESTAMPNS", 35)
+_ANCILLARY = socket.CMSG_SPACE(16)
 
 
 class SimError(RuntimeError):
@@ -141,6 +145,7 @@ class Hm2Sim:
         self._thread: Optional[threading.Thread] = None
         self._stop = threading.Event()
         self._t0 = 0.0
+        self._wall0 = 0.0
         self._pending: list[tuple[float, int, bytes, tuple[str, int]]] = []
         self._seq = 0
         self._log_path = log if isinstance(log, (str, Path)) else None
@@ -170,12 +175,16 @@ class Hm2Sim:
                     "or --address") from None
             raise SimError(f"cannot listen on UDP {self.address}:"
                            f"{self._port}: {exc.strerror}") from None
+        try:
+            sock.setsockopt(socket.SOL_SOCKET, _SO_TIMESTAMPNS, 1)
+        except OSError:
+            pass                    # no kernel timestamps: the thread's
         self._sock = sock
         self._port = sock.getsockname()[1]
         if self._log_path is not None:
             self._log = open(self._log_path, "w", encoding="utf-8")
             self._own_log = True
-        self._t0 = time.monotonic()
+        self._set_epoch()
         self._stop.clear()
         self._thread = threading.Thread(target=self._serve,
                                         name=f"hm2-sim {self.profile.key}",
@@ -194,9 +203,12 @@ class Hm2Sim:
         if self._sock is not None:
             self._sock.close()
             self._sock = None
-        if self._log is not None and self._own_log:
-            self._log.close()
-            self._log = None
+        if self._log is not None:
+            if self._own_log:
+                self._log.close()
+                self._log = None
+            else:
+                self._log.flush()
 
     def __enter__(self) -> Hm2Sim:
         return self.start()
@@ -214,6 +226,12 @@ class Hm2Sim:
     def _now(self) -> float:
         return time.monotonic() - self._t0
 
+    def _set_epoch(self) -> None:
+        """Card time 0: now (monotonic; the wall clock of the same
+        moment converts the kernel's receive timestamps)."""
+        self._t0 = time.monotonic()
+        self._wall0 = time.time() - (time.monotonic() - self._t0)
+
     def _serve(self) -> None:
         sock = self._sock
         assert sock is not None
@@ -225,14 +243,16 @@ class Hm2Sim:
                                                - time.monotonic()))
                 sock.settimeout(timeout)
                 try:
-                    packet, peer = sock.recvfrom(65536)
+                    packet, ancillary, _, peer = sock.recvmsg(
+                        65536, _ANCILLARY)
                 except (socket.timeout, BlockingIOError):
                     self._send_due(sock)
                     continue
                 except OSError:
                     continue
                 try:
-                    self._handle(sock, packet, peer)
+                    self._handle(sock, packet, peer,
+                                 self._arrival(ancillary))
                 except Exception as exc:        # noqa: BLE001
                     # a bug in the model must not take the card down
                     # silently: keep serving, keep the first error
@@ -257,15 +277,30 @@ class Hm2Sim:
             pass
 
     def _logline(self, text: str) -> None:
+        # buffered: flushed when the card stops (a flush per datagram
+        # would cost the next reply a system call)
         if self._log is not None:
             self._log.write(text + "\n")
-            self._log.flush()
+
+    def _arrival(self, ancillary: list[tuple[int, int, bytes]]
+                 ) -> Optional[float]:
+        """The card time at which the kernel received a datagram (its
+        SO_TIMESTAMPNS), so that a late server thread does not make the
+        datagram late: the card acts on a datagram when it arrives."""
+        for level, kind, data in ancillary:
+            if (level == socket.SOL_SOCKET and kind == _SO_TIMESTAMPNS
+                    and len(data) >= 16):
+                sec, nsec = struct.unpack_from("@qq", data)
+                return sec + nsec * 1e-9 - self._wall0
+        return None
 
     def _handle(self, sock: socket.socket, packet: bytes,
-                peer: tuple[str, int]) -> None:
+                peer: tuple[str, int],
+                arrival: Optional[float] = None) -> None:
         # the reply goes out first, the log is written after it: a driver
         # waits for the reply, not for the log
-        stamp = self._now()
+        now = self._now()
+        stamp = now if arrival is None else min(arrival, now)
         note = ""
         reply = b""
         copies = 0
@@ -363,7 +398,7 @@ class Hm2Sim:
         with self._lock:
             if self.faults.away and getattr(self, "_away_reset", True):
                 self.card.reset()
-                self._t0 = time.monotonic()
+                self._set_epoch()
             self.faults.away = False
 
     @property
