@@ -22,7 +22,9 @@
 # namespace hm2sim, behind a veth pair (10.96.7.1 on this side) whose far
 # end carries the MAC the profile reports.  Needs root (ip netns, ip link);
 # hm2_eth also adds an empty iptables chain hm2-eth-rules-output and a jump
-# to it from OUTPUT, and removes its ARP entry when it unloads.
+# to it from OUTPUT at each load (the script removes the jumps it caused at
+# the end), and removes its ARP entry when it unloads.  `ip netns del
+# hm2sim` removes the namespace and the veth pair.
 #
 # Environment: HM2SIM_PYTHON a Python with halsdk installed (default
 # python3), PERIOD the servo period in ns (default 1000000), KEEP=1 keeps
@@ -57,6 +59,20 @@ if ! ip netns list | grep -qw "$ns"; then
     ip -n "$ns" link set hm2sim1 up
     ip -n "$ns" link set lo up
 fi
+
+# hm2_eth adds a jump to its (empty) chain to OUTPUT at each load, even
+# when there is one: take the ones these runs add away at the end
+jumps() { iptables -S OUTPUT 2>/dev/null | grep -c -- "-j hm2-eth-rules-output" || true; }
+jumps_before=$(jumps)
+restore_jumps() {
+    local n
+    n=$(jumps)
+    while [ "$n" -gt "$jumps_before" ]; do
+        iptables -D OUTPUT -j hm2-eth-rules-output || break
+        n=$((n - 1))
+    done
+}
+trap restore_jumps EXIT
 
 for board in "${boards[@]}"; do
     out="$here/$board"
