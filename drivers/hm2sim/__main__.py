@@ -16,6 +16,7 @@ from .server import Hm2Sim, SimError
 CONTROL_HELP = """\
 commands (one a line, with --control):
   drop N | drop pP          drop the next N replies, or each with probability P
+  lose N | lose pP          lose datagrams to the card (reads and writes)
   duplicate N | duplicate pP
   truncate N | truncate pP
   delay SECONDS N | delay SECONDS pP
@@ -75,6 +76,8 @@ def parse_args(argv: Optional[Sequence[str]]) -> argparse.Namespace:
                    help="write every datagram, decoded, to FILE")
     p.add_argument("--drop", type=_probability, default=0.0, metavar="P",
                    help="drop each reply with probability P")
+    p.add_argument("--lose", type=_probability, default=0.0, metavar="P",
+                   help="lose each datagram to the card with probability P")
     p.add_argument("--duplicate", type=_probability, default=0.0,
                    metavar="P", help="send each reply twice with probability P")
     p.add_argument("--truncate", type=_probability, default=0.0,
@@ -127,7 +130,7 @@ def command(sim: Hm2Sim, line: str, out: TextIO) -> bool:
     try:
         if verb == "quit":
             return False
-        if verb in ("drop", "duplicate", "truncate"):
+        if verb in ("drop", "lose", "duplicate", "truncate"):
             n, p = _fault_args(args)
             getattr(f, verb)(next=n, probability=p)
         elif verb == "delay":
@@ -170,6 +173,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     sim = Hm2Sim(args.board, args.address, args.port, log=args.log,
                  seed=args.seed)
     sim.faults.drop(probability=args.drop)
+    sim.faults.lose(probability=args.lose)
     sim.faults.duplicate(probability=args.duplicate)
     sim.faults.truncate(probability=args.truncate)
     if args.delay:

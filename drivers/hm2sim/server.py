@@ -51,17 +51,19 @@ class Fault:
 
 
 class Faults:
-    """The faults of the replies, set from a test or the command line.
+    """The faults of the link, set from a test or the command line.
 
-    ``drop``, ``duplicate``, ``truncate`` and ``delay`` each take either
-    ``next=N`` (the next N replies) or ``probability=P`` (each reply), or
-    both.  ``delay`` also takes the delay in ``seconds``; ``truncate``
-    the number of bytes to keep (``keep``, default half of the reply).
+    ``lose`` (datagrams to the card), ``drop``, ``duplicate``, ``truncate``
+    and ``delay`` (its replies) each take either ``next=N`` (the next N)
+    or ``probability=P`` (each), or both.  ``delay`` also takes the delay
+    in ``seconds``; ``truncate`` the number of bytes to keep (``keep``,
+    default half of the reply).
     """
 
     def __init__(self, seed: Optional[int] = None) -> None:
         self.rng = random.Random(seed)
         self.dropped = Fault()
+        self.lost = Fault()
         self.duplicated = Fault()
         self.truncated = Fault()
         self.delayed = Fault()
@@ -79,7 +81,13 @@ class Faults:
         fault.probability = probability
 
     def drop(self, next: int = 0, probability: float = 0.0) -> None:
+        """The card does what a datagram asks but its reply is lost."""
         self._set(self.dropped, next, probability)
+
+    def lose(self, next: int = 0, probability: float = 0.0) -> None:
+        """Datagrams are lost on the way to the card (reads and writes
+        alike): the card never sees them."""
+        self._set(self.lost, next, probability)
 
     def duplicate(self, next: int = 0, probability: float = 0.0) -> None:
         self._set(self.duplicated, next, probability)
@@ -100,7 +108,7 @@ class Faults:
 
     def clear(self) -> None:
         """No faults (the card stays away if it is away)."""
-        for f in (self.dropped, self.duplicated, self.truncated,
+        for f in (self.dropped, self.lost, self.duplicated, self.truncated,
                   self.delayed):
             f.count, f.probability = 0, 0.0
 
@@ -114,6 +122,7 @@ class Stats:
     truncated: int
     delayed: int
     ignored: int            # requests while away
+    lost: int               # requests lost on the way (faults.lose)
     malformed: int
 
 
@@ -312,6 +321,9 @@ class Hm2Sim:
             if self.faults.away:
                 counts["ignored"] += 1
                 note = "(away)"
+            elif self.faults.lost.fire(self.faults.rng):
+                counts["lost"] += 1
+                note = "(lost)"
             else:
                 try:
                     commands = lbp16.parse(packet)

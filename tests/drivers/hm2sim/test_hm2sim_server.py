@@ -240,3 +240,18 @@ def test_a_model_error_does_not_stop_the_card(sim: Hm2Sim, client: Client,
     monkeypatch.undo()
     assert client.ask() == COOKIE_REPLY
     assert isinstance(sim.error, RuntimeError) and sim.running
+
+
+def test_lose_datagrams_to_the_card(sim: Hm2Sim, client: Client) -> None:
+    sim.faults.lose(next=2)
+    # a lost write never reaches the card
+    assert client.ask(lbp16.encode([lbp16.write(0, 0x0200, [5])]),
+                      QUIET) is None
+    assert client.ask(timeout=QUIET) is None       # a lost read
+    assert sim.leds == 0
+    assert client.ask(lbp16.encode([lbp16.write(0, 0x0200, [6]),
+                                    lbp16.read(0, 0x0200)])) == b"\6\0\0\0"
+    assert sim.stats.lost == 2
+    # the card counts only what reached it
+    reply = client.ask(bytes.fromhex("01590800"))
+    assert reply == b"\2\0"
