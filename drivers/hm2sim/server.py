@@ -191,7 +191,12 @@ class Hm2Sim:
         self._sock = sock
         self._port = sock.getsockname()[1]
         if self._log_path is not None:
-            self._log = open(self._log_path, "w", encoding="utf-8")
+            try:
+                self._log = open(self._log_path, "w", encoding="utf-8")
+            except OSError as exc:
+                sock.close()
+                raise SimError(f"cannot write the packet log "
+                               f"{self._log_path}: {exc.strerror}") from None
             self._own_log = True
         self._set_epoch()
         self._stop.clear()

@@ -112,3 +112,12 @@ def test_sigterm_stops_it(tmp_path: Path) -> None:
         if proc.poll() is None:
             proc.kill()
             proc.wait()
+
+
+def test_unwritable_log(tmp_path: Path) -> None:
+    proc = _run(["--port", "0", "--log", str(tmp_path / "no" / "log.txt")],
+                tmp_path)
+    assert proc.returncode == 1
+    assert proc.stderr.strip() == (
+        f"hm2-sim: error: cannot write the packet log {tmp_path}/no/log.txt: "
+        "No such file or directory")
