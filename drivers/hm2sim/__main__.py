@@ -59,6 +59,35 @@ def _port(text: str) -> int:
     return value
 
 
+def _switch(text: str) -> tuple[int, int, float, bool, bool]:
+    """``PIN:STEPGEN:>=STEPS[:low]`` (pin, stepgen, at, above, on_level)."""
+    parts = text.split(":")
+    try:
+        if len(parts) not in (3, 4) or parts[2][:2] not in (">=", "<="):
+            raise ValueError
+        if len(parts) == 4 and parts[3] != "low":
+            raise ValueError
+        return (int(parts[0]), int(parts[1]), float(parts[2][2:]),
+                parts[2].startswith(">="), len(parts) == 3)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"{text!r}: expected PIN:STEPGEN:>=STEPS or PIN:STEPGEN:<=STEPS, "
+            "optionally :low") from None
+
+
+def _couple(text: str) -> tuple[int, int, float]:
+    """``ENCODER:STEPGEN[:COUNTS_PER_STEP]``."""
+    parts = text.split(":")
+    try:
+        if len(parts) not in (2, 3):
+            raise ValueError
+        ratio = float(parts[2]) if len(parts) == 3 else 1.0
+        return int(parts[0]), int(parts[1]), ratio
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"{text!r}: expected ENCODER:STEPGEN[:COUNTS_PER_STEP]") from None
+
+
 def parse_args(argv: Optional[Sequence[str]]) -> argparse.Namespace:
     p = _Parser(
         prog="hm2-sim",
@@ -87,6 +116,16 @@ def parse_args(argv: Optional[Sequence[str]]) -> argparse.Namespace:
     p.add_argument("--delay-probability", type=_probability, default=1.0,
                    metavar="P", help="probability of --delay (default 1)")
     p.add_argument("--seed", type=int, help="seed of the fault dice")
+    p.add_argument("--switch", action="append", default=[], type=_switch,
+                   metavar="PIN:STEPGEN:>=STEPS[:low]",
+                   help="a home or limit switch on input PIN, on when "
+                        "stepgen STEPGEN's axis is at or above (>=) or at "
+                        "or below (<=) STEPS; ':low' when on reads 0 "
+                        "(repeatable)")
+    p.add_argument("--couple", action="append", default=[], type=_couple,
+                   metavar="ENCODER:STEPGEN[:COUNTS_PER_STEP]",
+                   help="drive an encoder from a stepgen's axis "
+                        "(repeatable)")
     p.add_argument("--control", action="store_true",
                    help="read commands from standard input (see below)")
     p.add_argument("-q", "--quiet", action="store_true",
@@ -178,6 +217,14 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     sim.faults.truncate(probability=args.truncate)
     if args.delay:
         sim.faults.delay(args.delay, probability=args.delay_probability)
+    try:
+        for pin, stepgen, at, above, on_level in args.switch:
+            sim.add_switch(pin, stepgen, at, above, on_level)
+        for encoder, stepgen, ratio in args.couple:
+            sim.couple(encoder, stepgen, ratio)
+    except IndexError as exc:
+        print(f"hm2-sim: error: {exc}", file=sys.stderr)
+        return 2
     done = threading.Event()
 
     def _stop(signum: int, frame: object) -> None:

@@ -103,11 +103,26 @@ class Encoder:
 
 @dataclass
 class Coupling:
+    """An encoder on the axis of a stepgen (positions of the world)."""
+
     encoder: int
     stepgen: int
     counts_per_step: float
     origin_steps: float
     origin_counts: int
+
+
+@dataclass
+class Switch:
+    """A switch on a stepgen's axis, wired to an input pin: on when the
+    axis is at or beyond ``at`` steps (above it, or below it); the pin
+    then reads ``on_level``, otherwise the opposite."""
+
+    pin: int
+    stepgen: int
+    at: float
+    above: bool = True
+    on_level: bool = True
 
 
 @dataclass
@@ -137,7 +152,8 @@ class Card:
 
     # --- state -------------------------------------------------------
     def reset(self) -> None:
-        """Power-on state (the card coming back after being away)."""
+        """Power-on state of the card and of its world (no switches, axes
+        at 0)."""
         p = self.profile
         self.ticks = 0                  # clock_low ticks since power-on
         self.time = 0.0
@@ -169,6 +185,8 @@ class Card:
         self.leds = 0
         self.misc = Registers()
         self.couplings: list[Coupling] = []
+        self.switches: list[Switch] = []
+        self.axis_offset = [0.0] * len(self.stepgens)
         self.address = [0] * 8           # current address of each space
         self.eeprom = bytearray(256)
         self.eeprom[2:8] = p.mac[::-1]   # the MAC, last byte first
@@ -176,6 +194,40 @@ class Card:
         self.ram = {lbp16.SPACE_TIMER: bytearray(256),
                     lbp16.SPACE_COMM: bytearray(256)}
         self.rx_packets = 0
+        self._build_maps()
+
+    def power_cycle(self) -> None:
+        """The card powers off and on: its registers start again (the
+        stepgen accumulators and encoder counts read 0), the world stays
+        (axis and encoder positions, field inputs, switches, couplings,
+        index pulses)."""
+        axes = [self.axis_steps(n) for n in range(len(self.stepgens))]
+        field = list(self.field)
+        encoders = self.encoders
+        couplings, switches = self.couplings, self.switches
+        self.reset()
+        self.axis_offset = axes
+        self.field = field
+        for old, new in zip(encoders, self.encoders):
+            new.position = new.offset = old.position
+            new.velocity, new.carry = old.velocity, old.carry
+            new.index_period = old.index_period
+        self.couplings, self.switches = couplings, switches
+        self._build_maps()
+
+    def axis_steps(self, n: int) -> float:
+        """The position of stepgen ``n``'s axis, in steps (the world's:
+        it survives a power cycle of the card)."""
+        return self.axis_offset[n] + self.stepgens[n].units / STEP_UNITS
+
+    def add_switch(self, switch: Switch) -> None:
+        if not 0 <= switch.pin < self.npins:
+            raise IndexError(f"I/O pin {switch.pin}: the {self.profile.key} "
+                             f"has pins 0..{self.npins - 1}")
+        if not 0 <= switch.stepgen < len(self.stepgens):
+            raise IndexError(f"stepgen {switch.stepgen}: the "
+                             f"{self.profile.key} has {len(self.stepgens)}")
+        self.switches.append(switch)
         self._build_maps()
 
     # --- time --------------------------------------------------------
@@ -217,7 +269,7 @@ class Card:
                     self._move_encoder(n, enc.position + whole,
                                        max(ticks - ago, ticks - delta))
         for c in self.couplings:
-            steps = self.stepgens[c.stepgen].steps - c.origin_steps
+            steps = self.axis_steps(c.stepgen) - c.origin_steps
             self._move_encoder(c.encoder, c.origin_counts
                                + round(steps * c.counts_per_step))
 
@@ -320,6 +372,13 @@ class Card:
     def port_levels(self, port: int) -> int:
         """The levels of a port's pins as the outside world sees them."""
         field = self.field[port]
+        for bit, sw in self._switches[port]:
+            axis = self.axis_steps(sw.stepgen)
+            on = axis >= sw.at if sw.above else axis <= sw.at
+            if on == sw.on_level:
+                field |= 1 << bit
+            else:
+                field &= ~(1 << bit)
         module = 0
         for pin, bit in self._module_pins[port]:
             enc = self._encoder_input(pin)
@@ -437,6 +496,11 @@ class Card:
             attr(reg(PWMGEN_BASE, 4), self, "pwm_enable", False)
             wr[reg(PWMGEN_BASE, 4)] = self._pwm_enable
         self._const, self._rd, self._wr = const, rd, wr
+        self._switches: list[list[tuple[int, Switch]]] = [
+            [] for _ in range(len(self.data))]
+        for sw in self.switches:
+            port, bit = divmod(sw.pin, self.port_width)
+            self._switches[port].append((bit, sw))
 
     def _wd_timer(self, value: int) -> None:
         self.watchdog.timeout = value

@@ -15,7 +15,7 @@ from types import TracebackType
 from typing import Optional, TextIO, Union
 
 from . import lbp16
-from .card import STEP_UNITS, Card
+from .card import Card, Coupling, Switch
 from .profiles import Profile, profile
 
 #: the longest a select() of the server thread waits, so stop() is prompt
@@ -405,7 +405,9 @@ class Hm2Sim:
 
     def go_away(self, reset: bool = True) -> None:
         """The card stops answering (unplugged or powered off); with
-        ``reset`` it comes back in its power-on state."""
+        ``reset`` it comes back powered on again: its registers in their
+        power-on state (stepgen accumulators and encoder counts at 0),
+        the machine's axes where they were."""
         with self._lock:
             self.faults.away = True
             self._away_reset = reset
@@ -414,7 +416,7 @@ class Hm2Sim:
         """The card answers again."""
         with self._lock:
             if self.faults.away and getattr(self, "_away_reset", True):
-                self.card.reset()
+                self.card.power_cycle()
                 self._set_epoch()
             self.faults.away = False
 
@@ -469,7 +471,7 @@ class Hm2Sim:
         with self._lock:
             self._check("stepgen", n, self.card.stepgens)  # type: ignore[arg-type]
             self._sync()
-            return self.card.stepgens[n].units / STEP_UNITS
+            return self.card.axis_steps(n)
 
     def stepgen(self, n: int) -> dict[str, float]:
         """The registers and position of stepgen ``n``."""
@@ -477,7 +479,8 @@ class Hm2Sim:
             self._check("stepgen", n, self.card.stepgens)  # type: ignore[arg-type]
             self._sync()
             sg = self.card.stepgens[n]
-            return {"position": sg.steps, "rate": sg.rate,
+            return {"position": self.card.axis_steps(n),
+                    "accumulator": sg.steps, "rate": sg.rate,
                     "steps_per_second": sg.rate * self.card.clock / 2**32,
                     "mode": sg.mode, "dir_setup": sg.dir_setup,
                     "dir_hold": sg.dir_hold, "step_len": sg.step_len,
@@ -523,14 +526,24 @@ class Hm2Sim:
     def couple(self, encoder: int, stepgen: int,
                counts_per_step: float = 1.0) -> None:
         """Drive encoder ``encoder`` from stepgen ``stepgen``'s axis."""
-        from .card import Coupling
         with self._lock:
             self._check("encoder", encoder, self.card.encoders)  # type: ignore[arg-type]
             self._check("stepgen", stepgen, self.card.stepgens)  # type: ignore[arg-type]
             self.card.couplings.append(Coupling(
                 encoder, stepgen, counts_per_step,
-                self.card.stepgens[stepgen].steps,
+                self.card.axis_steps(stepgen),
                 self.card.encoders[encoder].position))
+
+    def add_switch(self, pin: int, stepgen: int, at: float,
+                   above: bool = True, on_level: bool = True) -> None:
+        """A switch on stepgen ``stepgen``'s axis wired to input ``pin``:
+        on when the axis is at ``at`` steps or beyond (above it, or below
+        it with ``above=False``); the pin reads ``on_level`` when the
+        switch is on (``False`` for a normally closed switch), the
+        opposite otherwise.  Home and limit switches of a machine."""
+        with self._lock:
+            self.card.add_switch(Switch(pin, stepgen, float(at), above,
+                                        on_level))
 
     def pwm_duty(self, n: int) -> float:
         with self._lock:

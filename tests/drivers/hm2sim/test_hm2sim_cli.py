@@ -64,6 +64,9 @@ def test_port_in_use(tmp_path: Path) -> None:
     (["--drop", "2"], "'2': expected 0..1"),
     (["--port", "70000"], "'70000': expected 0..65535"),
     (["--delay", "100"], "--delay: expected 0..60 seconds"),
+    (["--switch", "1:2:=5"], "expected PIN:STEPGEN:>=STEPS"),
+    (["--switch", "1:9:>=5"], "stepgen 9: the 7i96s has 5"),
+    (["--couple", "0"], "expected ENCODER:STEPGEN"),
 ])
 def test_bad_command_line(args: list[str], message: str,
                           tmp_path: Path) -> None:
@@ -78,7 +81,8 @@ def test_control_commands(tmp_path: Path) -> None:
     script = "\n".join([
         "away", "back", "input 3 0", "encoder 0 42", "index 0", "drop 1",
         "delay 0.01 p0.5", "clear", "bogus", "status", "quit"]) + "\n"
-    proc = _run(["--board", "7I92", "--port", str(port), "--control"],
+    proc = _run(["--board", "7I92", "--port", str(port), "--control",
+                 "--switch", "20:0:<=-1:low"],
                 tmp_path, input=script)
     assert proc.returncode == 0, proc.stderr
     out = proc.stdout
@@ -92,6 +96,8 @@ def test_control_commands(tmp_path: Path) -> None:
     # encoder's A, B (position 42: phase 2) high
     pins = next(line for line in out.splitlines() if line.startswith("pins"))
     assert pins.split()[1][3] == "0" and len(pins.split()[1]) == 34
+    # the switch on pin 20 is off (the axis is at 0): it reads high
+    assert pins.split()[1][20] == "1"
 
 
 def test_sigterm_stops_it(tmp_path: Path) -> None:
@@ -121,3 +127,12 @@ def test_unwritable_log(tmp_path: Path) -> None:
     assert proc.stderr.strip() == (
         f"hm2-sim: error: cannot write the packet log {tmp_path}/no/log.txt: "
         "No such file or directory")
+
+
+def test_couple_and_switch_arguments() -> None:
+    from halsdk.drivers.hm2sim.__main__ import parse_args
+    args = parse_args(["--couple", "0:1", "--couple", "0:2:4.5",
+                       "--switch", "3:0:>=10", "--switch", "4:1:<=-2.5:low"])
+    assert args.couple == [(0, 1, 1.0), (0, 2, 4.5)]
+    assert args.switch == [(3, 0, 10.0, True, True),
+                           (4, 1, -2.5, False, False)]

@@ -177,9 +177,16 @@ def test_card_goes_away_and_comes_back(sim: Hm2Sim, client: Client) -> None:
     sim.go_away()
     assert client.ask(timeout=QUIET) is None
     assert sim.stats.ignored == 1
+    axis = sim.axis_position(0)
+    sim.set_input(2, False)
     sim.come_back()
     assert client.ask() == COOKIE_REPLY
-    assert sim.axis_position(0) == 0            # it was powered off
+    # it was powered off: its registers start again, the machine stays
+    (acc,) = struct.unpack("<I", client.ask(lbp16.encode(
+        [lbp16.read(0, 0x2100)])))
+    assert acc == 0 and sim.stepgen(0)["rate"] == 0
+    assert sim.axis_position(0) == axis
+    assert not sim.pin(2)
 
 
 def test_away_without_reset_keeps_the_state(sim: Hm2Sim,
@@ -255,3 +262,23 @@ def test_lose_datagrams_to_the_card(sim: Hm2Sim, client: Client) -> None:
     # the card counts only what reached it
     reply = client.ask(bytes.fromhex("01590800"))
     assert reply == b"\2\0"
+
+
+def test_switches_on_an_axis(sim: Hm2Sim, client: Client) -> None:
+    sim.add_switch(0, stepgen=1, at=100)                    # home, NO
+    sim.add_switch(1, stepgen=1, at=-50, above=False, on_level=False)
+    rate = round(1000 * 2**32 / 100e6)
+    client.ask(lbp16.encode([lbp16.write(0, 0x2004, [rate])]), QUIET)
+    sim.step(0.05)                                          # 50 steps
+    assert not sim.pin(0) and sim.pin(1)
+    sim.step(0.06)                                          # 110 steps
+    assert sim.pin(0) and sim.pin(1)
+    (port0,) = struct.unpack("<I", client.ask(lbp16.encode(
+        [lbp16.read(0, 0x1000)])))
+    assert port0 & 3 == 3
+    client.ask(lbp16.encode([lbp16.write(0, 0x2004, [-rate & 0xFFFFFFFF])]),
+               QUIET)
+    sim.step(0.2)                                           # -90 steps
+    assert not sim.pin(0) and not sim.pin(1)                # limit: NC open
+    with pytest.raises(IndexError, match="stepgen 7"):
+        sim.add_switch(0, 7, 1.0)
