@@ -16,15 +16,15 @@
 #   configs.txt     what the reference prints for config strings that it
 #                   accepts or refuses against this card (one load each)
 #
-# Why a network namespace: hm2_eth reads the card's MAC address and sets a
-# static ARP entry for the card (SIOCSARP), which the loopback interface
-# refuses (EINVAL).  So the card lives at 10.96.7.2 in the network
-# namespace hm2sim, behind a veth pair (10.96.7.1 on this side) whose far
-# end carries the MAC the profile reports.  Needs root (ip netns, ip link);
+# Why a network namespace (netns.sh): hm2_eth reads the card's MAC address
+# and sets a static ARP entry for the card (SIOCSARP), which the loopback
+# interface refuses (EINVAL).  So the card lives at 10.96.7.2 in the
+# network namespace hm2sim, behind a veth pair (10.96.7.1 on this side)
+# whose far end carries the MAC the profile reports.  Needs root;
 # hm2_eth also adds an empty iptables chain hm2-eth-rules-output and a jump
 # to it from OUTPUT at each load (the script removes the jumps it caused at
-# the end), and removes its ARP entry when it unloads.  `ip netns del
-# hm2sim` removes the namespace and the veth pair.
+# the end), and removes its ARP entry when it unloads.  `netns.sh down`
+# removes the namespace and the veth pair.
 #
 # Environment: HM2SIM_PYTHON a Python with halsdk installed (default
 # python3), PERIOD the servo period in ns (default 1000000), KEEP=1 keeps
@@ -40,7 +40,6 @@ here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../../.." && pwd)
 python=${HM2SIM_PYTHON:-python3}
 ns=hm2sim
-host_ip=10.96.7.1
 card_ip=10.96.7.2
 boards=("$@")
 configs=("num_stepgens=6" "num_encoders=2" "num_pwmgens=1" "num_pwmgens=2"
@@ -50,15 +49,7 @@ configs=("num_stepgens=6" "num_encoders=2" "num_pwmgens=1" "num_pwmgens=2"
 [ ${#boards[@]} -gt 0 ] || boards=(7i96s 7i92)
 export PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin
 
-if ! ip netns list | grep -qw "$ns"; then
-    ip netns add "$ns"
-    ip link add hm2sim0 type veth peer name hm2sim1 netns "$ns"
-    ip addr add "$host_ip/24" dev hm2sim0
-    ip link set hm2sim0 up
-    ip -n "$ns" addr add "$card_ip/24" dev hm2sim1
-    ip -n "$ns" link set hm2sim1 up
-    ip -n "$ns" link set lo up
-fi
+"$here/netns.sh" up
 
 # hm2_eth adds a jump to its (empty) chain to OUTPUT at each load, even
 # when there is one: take the ones these runs add away at the end
@@ -78,10 +69,8 @@ for board in "${boards[@]}"; do
     out="$here/$board"
     mkdir -p "$out"
     rm -f "$out"/*.txt
-    mac=$(cd /tmp && "$python" -c "from halsdk.drivers.hm2sim import profile; print(profile('$board').mac.hex(':'))")
     config=$(cd /tmp && "$python" -c "from halsdk.drivers.hm2sim import profile; print(profile('$board').config)")
-    ip -n "$ns" link set hm2sim1 address "$mac"
-    ip neigh flush dev hm2sim0
+    HM2SIM_PYTHON="$python" "$here/netns.sh" up "$board"
     work=$(mktemp -d /tmp/hm2sim-regen.XXXXXX)
     chmod 755 "$work"
     name="hm2_$board.0"
