@@ -1,0 +1,71 @@
+"""Helpers of the hm2_eth tests (tests/drivers/hm2_eth): the simulated
+card (hm2-sim) with its clock stepped by the test, and hm2_eth loaded
+against it."""
+
+from __future__ import annotations
+
+import importlib
+import os
+from types import ModuleType
+
+import pytest
+
+#: where to find the simulator while it lives on another branch
+#: (HM2SIM_DRIVERS: a folder holding the hm2sim package)
+_SIM_FOLDERS = [os.environ.get("HM2SIM_DRIVERS", ""), "/work/wt-hm2sim/drivers"]
+
+PERIOD = 1_000_000                  # ns: the servo thread of the tests
+#: packet-read-timeout of the tests (ns): the simulated card is a Python
+#: thread on a shared machine, slower to answer than a card
+READ_TIMEOUT = 200_000_000
+
+
+def hm2sim() -> ModuleType:
+    """The simulator package, halsdk.drivers.hm2sim."""
+    try:
+        return importlib.import_module("halsdk.drivers.hm2sim")
+    except ImportError:
+        pass
+    import halsdk.drivers
+    for folder in _SIM_FOLDERS:
+        if folder and os.path.isfile(os.path.join(folder, "hm2sim",
+                                                  "__init__.py")):
+            halsdk.drivers.__path__.append(folder)
+            return importlib.import_module("halsdk.drivers.hm2sim")
+    pytest.skip("the simulated card (halsdk.drivers.hm2sim) is missing")
+
+
+class Rig:
+    """hm2_eth on a HAL thread against a simulated card whose clock moves
+    one period per cycle: :meth:`cycle` runs the thread once."""
+
+    def __init__(self, hal, sim, board: str) -> None:
+        self.hal = hal
+        self.sim = sim
+        self.p = f"hm2_{board}.0."
+
+    def cycle(self, n: int = 1) -> None:
+        for _ in range(n):
+            self.sim.step(PERIOD * 1e-9)
+            self.hal.step(1)
+
+    def get(self, name: str):
+        return self.hal.getp(self.p + name)
+
+    def set(self, name: str, value) -> None:
+        self.hal.setp(self.p + name, value)
+
+
+def load(hal, sim, config: str = "", board: str = "7i96s",
+         functs: tuple[str, ...] = ("read", "write")) -> Rig:
+    hal.loadrt("hostmot2")
+    words = [f"board_ip=127.0.0.1:{sim.port}"]
+    if config:
+        words.append(f'config="{config}"')
+    hal.loadrt("hm2_eth", *words)
+    hal.newthread("servo", PERIOD)
+    rig = Rig(hal, sim, board)
+    for f in functs:
+        hal.addf(rig.p + f, "servo")
+    rig.set("packet-read-timeout", READ_TIMEOUT)
+    return rig
