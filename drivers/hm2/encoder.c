@@ -15,7 +15,7 @@
 
 #include "hm2.h"
 
-enum { R_COUNTER, R_LATCH };
+enum { R_COUNTER, R_LATCH, R_TSDIV, R_TSCOUNT, R_RATE };
 #define CTRL_QUAD_ERROR (1u << 15)
 #define CTRL_FILTER (1u << 11)
 #define CTRL_COUNTER_MODE (1u << 10)
@@ -54,7 +54,9 @@ int hm2_encoder_setup(struct hm2_board *b, int comp_id)
     for (i = 0; i < en->num && r == 0; i++) {
         struct hm2_encoder_inst *e = &en->inst[i];
         PIN(s32, HAL_OUT, count, "count");
+        PIN(s32, HAL_OUT, count_latched, "count-latched");
         PIN(s32, HAL_OUT, rawcounts, "rawcounts");
+        PIN(s32, HAL_OUT, rawlatch, "rawlatch");
         PIN(float, HAL_OUT, position, "position");
         PIN(float, HAL_OUT, position_latched, "position-latched");
         PIN(float, HAL_OUT, velocity, "velocity");
@@ -80,8 +82,16 @@ int hm2_encoder_setup(struct hm2_board *b, int comp_id)
         e->vel_timeout = 0.5;
         en->ctrl_dirty[i] = 1;
     }
+    if (!r)
+        r = hal_pin_bit_newf(HAL_IN, &en->hires_timestamp, comp_id,
+                             "%s.encoder.hires-timestamp", b->name);
+    if (!r)
+        r = hal_pin_u32_newf(HAL_IN, &en->sample_frequency, comp_id,
+                             "%s.encoder.sample-frequency", b->name);
     if (r < 0)
         return r;
+    *en->hires_timestamp = 0;
+    *en->sample_frequency = 25000000;
     r = hm2_read_regs(b, en->md, R_COUNTER, en->num, en->counter);
     if (!r)
         r = hm2_read_regs(b, en->md, R_LATCH, en->num, en->latch);
@@ -104,8 +114,12 @@ void hm2_encoder_process(struct hm2_board *b, long period)
         /* the index came: latch-on-index armed and now cleared */
         if (e->index_armed == 2 && !(latch & CTRL_LATCH_ON_INDEX)) {
             short to_latch = (short)(u16)((latch >> 16) - e->last);
-            e->zero = e->total + (e->primed ? to_latch : 0);
-            *e->position_latched = (double)(e->zero) / scale;
+            long long at = e->total + (e->primed ? to_latch : 0);
+            /* the count at the index, then the index is count 0 */
+            *e->rawlatch = (s32)at;
+            *e->count_latched = (s32)(at - e->zero);
+            *e->position_latched = (double)(at - e->zero) / scale;
+            e->zero = at;
             if (*e->index_enable)
                 *e->index_enable = 0;
             e->index_armed = 0;
@@ -136,6 +150,20 @@ void hm2_encoder_prepare(struct hm2_board *b)
 {
     struct hm2_encoder *en = &b->enc;
     int i, any = 0;
+    u32 freq, rate;
+
+    if (en->num == 0)
+        return;
+    /* the filter's sample clock: the module clock divided by rate + 2 */
+    freq = *en->sample_frequency;
+    if (freq < 1)
+        freq = 1;
+    rate = en->clock_hz / freq;
+    rate = rate < 2 ? 0 : rate - 2;
+    if (rate != en->w_rate || b->force_write) {
+        hm2_queue_write(b, hm2_reg_addr(en->md, R_RATE), &rate, 1);
+        en->w_rate = rate;
+    }
     for (i = 0; i < en->num; i++) {
         struct hm2_encoder_inst *e = &en->inst[i];
         u32 c = 0;

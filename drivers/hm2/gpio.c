@@ -7,10 +7,11 @@
  * 4 output invert (when the firmware has it; otherwise a GPIO output is
  * inverted here).
  *
- * HAL, per pin NNN (hostmot2(9)): a plain GPIO has the pins in, in_not,
- * out and the params is_output, is_opendrain, invert_output; a pin a
- * module reads has in and in_not; a pin a module drives has
- * is_opendrain and invert_output.  The data register is read each cycle
+ * HAL, per pin NNN (as the reference makes them): every pin has the pins
+ * in and in_not (the level on the connector); a plain GPIO also has the
+ * pin out and the params is_output, is_opendrain, invert_output; a pin a
+ * module drives has is_opendrain and invert_output (shown under their
+ * aliases, see pins.c).  The data register is read each cycle
  * and written each cycle; the others when they change.
  */
 #include <errno.h>
@@ -59,13 +60,11 @@ int hm2_gpio_setup(struct hm2_board *b, int comp_id)
                 io->module_out[port] |= 1u << bit;
             }
         }
-        if (!module_out) {
-            r = hal_pin_bit_newf(HAL_OUT, &g->in, comp_id,
-                                 "%s.gpio.%03d.in", b->name, i);
-            if (!r)
-                r = hal_pin_bit_newf(HAL_OUT, &g->in_not, comp_id,
-                                     "%s.gpio.%03d.in_not", b->name, i);
-        }
+        r = hal_pin_bit_newf(HAL_OUT, &g->in, comp_id, "%s.gpio.%03d.in",
+                             b->name, i);
+        if (!r)
+            r = hal_pin_bit_newf(HAL_OUT, &g->in_not, comp_id,
+                                 "%s.gpio.%03d.in_not", b->name, i);
         if (!module) {
             if (!r)
                 r = hal_pin_bit_newf(HAL_IN, &g->out, comp_id,

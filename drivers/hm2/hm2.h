@@ -185,7 +185,7 @@ struct hm2_watchdog {
 };
 
 struct hm2_encoder_inst {
-    hal_s32_t *count, *rawcounts;
+    hal_s32_t *count, *rawcounts, *count_latched, *rawlatch;
     hal_float_t *position, *velocity, *velocity_rpm;
     hal_float_t *position_latched;
     hal_bit_t *reset, *index_enable, *latch_enable, *latch_polarity;
@@ -212,6 +212,9 @@ struct hm2_encoder {
     u32 ctrl[HM2_MAX_INST];     /* to write */
     int ctrl_dirty[HM2_MAX_INST];
     u32 clock_hz;
+    hal_bit_t *hires_timestamp;
+    hal_u32_t *sample_frequency;
+    u32 w_rate;
     struct hm2_encoder_inst *inst;
 };
 
@@ -222,6 +225,10 @@ struct hm2_stepgen_inst {
     hal_bit_t *enable, *control_type, *position_reset;
     hal_float_t position_scale, maxvel, maxaccel;
     hal_u32_t steplen, stepspace, dirsetup, dirhold, step_type;
+    hal_u32_t table_data[4];
+    hal_float_t *dbg_ff_vel, *dbg_vel_error, *dbg_s_to_match,
+        *dbg_err_at_match, *dbg_pos_minus_prev_cmd;
+    hal_s32_t *dbg_step_rate;
     /* state */
     long long total_counts;     /* extended step count (16.16 in acc) */
     long long zero;             /* subtracted: position-reset */
@@ -312,7 +319,8 @@ struct hm2_board {
     hal_bit_t *packet_error;
     hal_s32_t *packet_error_level;
     hal_bit_t *packet_error_exceeded;
-    hal_bit_t *io_error;
+    hal_u32_t *packet_error_total;
+    hal_bit_t io_error;                 /* a param, as the reference's */
     hal_s32_t packet_error_decrement;
     hal_s32_t packet_error_increment;
     hal_s32_t packet_error_limit;

@@ -69,10 +69,11 @@ int hm2_add_region(struct hm2_board *b, u16 addr, int count, u32 *dst)
 int hm2_read_regs(struct hm2_board *b, const struct hm2_module_desc *md,
                   int reg, int n, u32 *dst)
 {
-    u16 addr = hm2_reg_addr(md, reg);
+    u16 addr;
     int i, r;
     if (n <= 0)
         return 0;
+    addr = hm2_reg_addr(md, reg);
     if (md->instance_stride == 4)
         return hm2_add_region(b, addr, n, dst);
     for (i = 0; i < n; i++) {
@@ -106,10 +107,11 @@ void hm2_queue_write(struct hm2_board *b, u16 addr, const u32 *data,
 void hm2_write_regs(struct hm2_board *b, const struct hm2_module_desc *md,
                     int reg, int n, const u32 *src)
 {
-    u16 addr = hm2_reg_addr(md, reg);
+    u16 addr;
     int i;
     if (n <= 0)
         return;
+    addr = hm2_reg_addr(md, reg);
     if (md->instance_stride == 4) {
         hm2_queue_write(b, addr, src, n);
         return;
@@ -163,6 +165,7 @@ static void account(struct hm2_board *b)
 {
     s32 level = *b->packet_error_level, limit = b->packet_error_limit;
     if (b->cycle_error) {
+        *b->packet_error_total += 1;
         level += b->packet_error_increment;
         if (level > limit)
             level = limit;
@@ -175,7 +178,7 @@ static void account(struct hm2_board *b)
     *b->packet_error_level = level;
     *b->packet_error_exceeded = level >= limit;
     if (b->cycle_error && level >= limit) {
-        *b->io_error = 1;
+        b->io_error = 1;
         b->io_error_was = 1;
         HM2_ERR(b, "%s: packet error level %d reached the limit %d: the "
                 "board stops (set %s.io_error false to resume)",
@@ -187,7 +190,7 @@ static void account(struct hm2_board *b)
 /* true while the board is stopped by an I/O error; notices the reset */
 static int stopped(struct hm2_board *b)
 {
-    if (*b->io_error) {
+    if (b->io_error) {
         b->io_error_was = 1;
         return 1;
     }
@@ -316,10 +319,13 @@ static int export_board(struct hm2_board *b)
         r = hal_pin_bit_newf(HAL_OUT, &b->packet_error_exceeded, comp_id,
                              "%s.packet-error-exceeded", b->name);
     if (!r)
-        r = hal_pin_bit_newf(HAL_IO, &b->io_error, comp_id, "%s.io_error",
-                             b->name);
+        r = hal_pin_u32_newf(HAL_IO, &b->packet_error_total, comp_id,
+                             "%s.packet-error-total", b->name);
     if (!r)
-        r = hal_param_s32_newf(HAL_RW, &b->packet_error_decrement, comp_id,
+        r = hal_param_bit_newf(HAL_RW, &b->io_error, comp_id, "%s.io_error",
+                               b->name);
+    if (!r)
+        r = hal_param_s32_newf(HAL_RO, &b->packet_error_decrement, comp_id,
                                "%s.packet-error-decrement", b->name);
     if (!r)
         r = hal_param_s32_newf(HAL_RW, &b->packet_error_increment, comp_id,
@@ -335,7 +341,8 @@ static int export_board(struct hm2_board *b)
     *b->packet_error = 0;
     *b->packet_error_level = 0;
     *b->packet_error_exceeded = 0;
-    *b->io_error = 0;
+    *b->packet_error_total = 0;
+    b->io_error = 0;
     b->packet_error_decrement = 1;
     b->packet_error_increment = 2;
     b->packet_error_limit = 10;

@@ -80,6 +80,8 @@ void hm2_pwmgen_prepare(struct hm2_board *b)
     struct hm2_pwmgen *pw = &b->pwm;
     int i, dirty = b->force_write;
     u32 en = 0, v;
+    if (pw->num == 0)
+        return;
     for (i = 0; i < pw->num; i++) {
         struct hm2_pwmgen_inst *p = &pw->inst[i];
         double scale = p->scale == 0.0 ? 1.0 : p->scale;

@@ -23,6 +23,8 @@
 
 #include "hm2.h"
 
+#define TIMING_MAX 0x3fff         /* ticks: the timing registers' width */
+
 enum { R_RATE, R_ACCUM, R_MODE, R_DIRSETUP, R_DIRHOLD, R_STEPLEN,
        R_STEPSPACE, R_TABLE, R_TABLEWIDTH };
 
@@ -66,15 +68,25 @@ int hm2_stepgen_setup(struct hm2_board *b, int comp_id)
         PARAM(u32, dirsetup, "dirsetup");
         PARAM(u32, dirhold, "dirhold");
         PARAM(u32, step_type, "step_type");
+        PARAM(u32, table_data[0], "table-data-0");
+        PARAM(u32, table_data[1], "table-data-1");
+        PARAM(u32, table_data[2], "table-data-2");
+        PARAM(u32, table_data[3], "table-data-3");
+        PIN(float, HAL_OUT, dbg_ff_vel, "dbg_ff_vel");
+        PIN(float, HAL_OUT, dbg_vel_error, "dbg_vel_error");
+        PIN(float, HAL_OUT, dbg_s_to_match, "dbg_s_to_match");
+        PIN(float, HAL_OUT, dbg_err_at_match, "dbg_err_at_match");
+        PIN(float, HAL_OUT, dbg_pos_minus_prev_cmd, "dbg_pos_minus_prev_cmd");
+        PIN(s32, HAL_OUT, dbg_step_rate, "dbg_step_rate");
         if (r)
             break;
         s->position_scale = 1.0;
         s->maxvel = 0.0;
         s->maxaccel = 1.0;
-        s->steplen = 2000;
-        s->stepspace = 2000;
-        s->dirsetup = 1000;
-        s->dirhold = 1000;
+        /* the timings start at the longest the registers hold, as the
+           reference's do: safe for any drive until they are set */
+        s->steplen = s->stepspace = s->dirsetup = s->dirhold =
+            (u32)(TIMING_MAX * 1e9 / sg->clock_hz);
         s->step_type = 0;
     }
     if (r < 0)
@@ -108,10 +120,10 @@ void hm2_stepgen_process(struct hm2_board *b, long period)
 
 static u32 ticks(u32 ns, u32 clock_hz)
 {
-    double t = (double)ns * clock_hz / 1e9;
-    if (t > 0x3fff)
-        t = 0x3fff;
-    return (u32)ceil(t);
+    double t = ceil((double)ns * clock_hz / 1e9);
+    if (t > TIMING_MAX)
+        t = TIMING_MAX;
+    return (u32)t;
 }
 
 static double max_step_rate(struct hm2_stepgen_inst *s, u32 clock_hz)
@@ -141,6 +153,9 @@ static double step_velocity(struct hm2_stepgen_inst *s, double dt,
         double cmd = *s->position_cmd;
         double ff = (cmd - s->old_pos_cmd) / dt;
         double err = cmd - s->fb_pos, fix = fabs(err) / dt;
+        *s->dbg_pos_minus_prev_cmd = s->fb_pos - s->old_pos_cmd;
+        *s->dbg_ff_vel = ff;
+        *s->dbg_err_at_match = err;
         s->old_pos_cmd = cmd;
         if (a > 0) {
             /* no faster than what still stops at the target, relative
@@ -155,6 +170,8 @@ static double step_velocity(struct hm2_stepgen_inst *s, double dt,
         target = vmax;
     if (target < -vmax)
         target = -vmax;
+    *s->dbg_vel_error = target - s->cur_vel;
+    *s->dbg_s_to_match = a > 0 ? fabs(target - s->cur_vel) / a : 0.0;
     if (a > 0) {
         if (target > s->cur_vel + a * dt)
             target = s->cur_vel + a * dt;
@@ -173,6 +190,8 @@ void hm2_stepgen_prepare(struct hm2_board *b, long period)
         dirsetup[HM2_MAX_INST], dirhold[HM2_MAX_INST], mode[HM2_MAX_INST],
         width[HM2_MAX_INST];
 
+    if (sg->num == 0)
+        return;
     for (i = 0; i < sg->num; i++) {
         struct hm2_stepgen_inst *s = &sg->inst[i];
         double scale = s->position_scale == 0.0 ? 1.0 : s->position_scale;
@@ -190,6 +209,7 @@ void hm2_stepgen_prepare(struct hm2_board *b, long period)
         if (rate < -2147483647.0)
             rate = -2147483647.0;
         sg->rate[i] = (u32)(s32)lrint(rate);
+        *s->dbg_step_rate = (s32)sg->rate[i];
 
         steplen[i] = ticks(s->steplen, sg->clock_hz);
         stepspace[i] = ticks(s->stepspace, sg->clock_hz);

@@ -7,7 +7,7 @@ import socket
 import time
 
 import pytest
-from helpers.hm2 import load
+from helpers.hm2 import PERIOD, load
 
 from halsdk.core import _core
 from halsdk.errors import HalError, InvalidError
@@ -39,11 +39,15 @@ def test_names_types_directions(rig):
     assert pins[p + "packet-error-level"] == (_core.S32, _core.OUT)
     assert pins[p + "packet-error-exceeded"] == (_core.BIT, _core.OUT)
     assert p + "stepgen.05.position-cmd" not in pins
-    # pins a module drives have no in/out of their own; those it reads
-    # keep in/in_not (GPIO 17: stepgen 0's step; 27: encoder A)
-    assert p + "gpio.017.in" not in pins and p + "gpio.017.out" not in pins
+    # every I/O pin shows its level; a pin a module uses has no out
+    # (GPIO 17: stepgen 0's step; 27: encoder A) and, when the module
+    # drives it, its settings under the module's name
+    assert p + "gpio.017.in" in pins and p + "gpio.017.out" not in pins
     assert p + "gpio.027.in" in pins and p + "gpio.027.out" not in pins
     params = kinds(hal.params(p + "*"))
+    assert p + "stepgen.00.step.invert_output" in params
+    assert p + "gpio.027.invert_output" not in params
+    assert params[p + "io_error"] == (_core.BIT, _core.RW)
     assert params[p + "watchdog.timeout_ns"][0] == _core.U32
     assert params[p + "gpio.000.is_output"][0] == _core.BIT
     assert params[p + "stepgen.00.maxaccel"][0] == _core.FLOAT
@@ -187,3 +191,300 @@ def test_watchdog_timeout_param(rig):
     rig.sim.step(0.060)
     rig.cycle(1)
     assert rig.get("watchdog.has_bit")
+
+
+# ------------------------------------------------------------------ stepgen
+
+def setup_stepgen(rig, n=0, scale=100.0, maxvel=10.0, maxaccel=100.0):
+    s = f"stepgen.{n:02d}."
+    rig.set(s + "position-scale", scale)
+    rig.set(s + "maxvel", maxvel)
+    rig.set(s + "maxaccel", maxaccel)
+    for t in ("steplen", "stepspace", "dirsetup", "dirhold"):
+        rig.set(s + t, 2000)
+    rig.set(s + "enable", 1)
+    return s
+
+
+def run_recording(rig, s, cycles):
+    vels = []
+    for _ in range(cycles):
+        rig.cycle()
+        vels.append(rig.get(s + "velocity-fb"))
+    return vels
+
+
+def assert_limited(vels, maxvel, maxaccel):
+    dt = PERIOD * 1e-9
+    assert max(abs(v) for v in vels) <= maxvel * (1 + 1e-9)
+    steps = [abs(b - a) / dt for a, b in zip([0.0] + vels, vels)]
+    assert max(steps) <= maxaccel * (1 + 1e-6)
+
+
+@pytest.mark.parametrize("target", [2.0, -1.25])
+def test_stepgen_moves_the_axis_within_limits(rig, target):
+    s = setup_stepgen(rig)
+    rig.set(s + "position-cmd", target)
+    vels = run_recording(rig, s, 500)
+    assert_limited(vels, 10.0, 100.0)
+    assert max(abs(v) for v in vels) == pytest.approx(10.0)
+    assert rig.sim.axis_position(0) == pytest.approx(target * 100, abs=1)
+    assert rig.get(s + "position-fb") == pytest.approx(target, abs=0.01)
+    assert rig.get(s + "counts") == pytest.approx(target * 100, abs=1)
+    assert abs(rig.get(s + "velocity-fb")) < 1e-6
+    # the other axes did not move
+    assert rig.sim.axis_position(1) == 0
+
+
+def test_stepgen_follows_a_moving_command(rig):
+    s = setup_stepgen(rig, n=2)
+    pos = 0.0
+    for i in range(300):                # a ramp at 3 units/s
+        pos = 3.0 * i * PERIOD * 1e-9
+        rig.set(s + "position-cmd", pos)
+        rig.cycle()
+    assert rig.get(s + "velocity-fb") == pytest.approx(3.0, rel=1e-3)
+    assert rig.get(s + "position-fb") == pytest.approx(pos, abs=0.02)
+
+
+def test_stepgen_velocity_mode(rig):
+    s = setup_stepgen(rig, n=1, maxaccel=50.0)
+    rig.set(s + "control-type", 1)
+    rig.set(s + "velocity-cmd", 20.0)       # above maxvel: clamped
+    vels = run_recording(rig, s, 400)
+    assert_limited(vels, 10.0, 50.0)
+    assert vels[-1] == pytest.approx(10.0)
+    before = rig.sim.axis_position(1)
+    rig.cycle(100)                          # 0.1 s at 10 units/s
+    assert rig.sim.axis_position(1) - before == pytest.approx(100, abs=2)
+
+
+def test_stepgen_disable_stops_at_once(rig):
+    s = setup_stepgen(rig)
+    rig.set(s + "position-cmd", 100.0)
+    rig.cycle(200)
+    rig.set(s + "enable", 0)
+    rig.cycle(2)
+    at = rig.sim.axis_position(0)
+    rig.cycle(20)
+    assert rig.sim.axis_position(0) == at
+    assert rig.get(s + "velocity-fb") == 0
+
+
+def test_stepgen_timings_and_step_type(rig):
+    s = "stepgen.03."
+    rig.set(s + "steplen", 5000)            # ns; 100 MHz clock: 500 ticks
+    rig.set(s + "stepspace", 1000)
+    rig.set(s + "dirsetup", 30)             # rounded up to whole ticks
+    rig.set(s + "dirhold", 0)
+    rig.set(s + "step_type", 2)
+    rig.cycle(2)
+    reg = rig.sim.stepgen(3)
+    assert (reg["step_len"], reg["step_space"]) == (500, 100)
+    assert (reg["dir_setup"], reg["dir_hold"]) == (3, 0)
+    assert reg["mode"] == 2
+
+
+def test_stepgen_position_reset(rig):
+    s = setup_stepgen(rig)
+    rig.set(s + "position-cmd", 0.5)
+    rig.cycle(300)
+    rig.set(s + "position-reset", 1)
+    rig.cycle(1)
+    assert rig.get(s + "position-fb") == 0 and rig.get(s + "counts") == 0
+
+
+# ------------------------------------------------------------------ encoder
+
+def test_encoder_follows_the_position(rig):
+    e = "encoder.00."
+    rig.set(e + "scale", 4.0)
+    # the card's counter has 16 bits: it wraps, and is followed while it
+    # moves less than 32767 counts between two reads
+    for counts in (10, 1000, 30000, 60000, 65636, 90000, 60000, 30000, -5):
+        rig.sim.set_encoder(0, counts)
+        rig.cycle(1)
+        assert rig.get(e + "count") == counts
+        assert rig.get(e + "rawcounts") == counts
+        assert rig.get(e + "position") == pytest.approx(counts / 4.0)
+
+
+def test_encoder_velocity_and_inputs(rig):
+    e = "encoder.00."
+    rig.cycle(1)
+    rig.sim.set_encoder_velocity(0, 2000.0)         # counts/s
+    rig.cycle(50)
+    assert rig.get(e + "velocity") == pytest.approx(2000.0, rel=0.01)
+    assert rig.get(e + "velocity-rpm") == pytest.approx(120000.0, rel=0.01)
+    rig.sim.set_encoder_velocity(0, 0.0)
+    for counts, a, b in ((0, False, False), (1, True, False),
+                         (2, True, True), (3, False, True)):
+        rig.sim.set_encoder(0, counts)
+        rig.cycle(1)
+        assert (rig.get(e + "input-a"), rig.get(e + "input-b")) == (a, b)
+        assert rig.get("gpio.027.in") == a          # encoder A's pin
+
+
+def test_encoder_reset(rig):
+    e = "encoder.00."
+    rig.sim.set_encoder(0, 300)
+    rig.cycle(1)
+    rig.set(e + "reset", 1)
+    rig.cycle(1)
+    assert rig.get(e + "count") == 0
+    rig.set(e + "reset", 0)
+    rig.sim.set_encoder(0, 310)
+    rig.cycle(1)
+    assert rig.get(e + "count") == 10 and rig.get(e + "rawcounts") == 310
+
+
+def test_encoder_index_enable_resets_on_index(rig):
+    e = "encoder.00."
+    rig.sim.set_encoder(0, 500)
+    rig.cycle(2)
+    rig.sim.pulse_index(0)                  # not armed: no effect
+    rig.cycle(2)
+    assert rig.get(e + "count") == 500
+    rig.set(e + "index-enable", 1)
+    rig.cycle(2)
+    assert rig.get(e + "index-enable")      # waiting for the index
+    rig.sim.set_encoder(0, 700)
+    rig.sim.pulse_index(0)                  # the index at count 700
+    rig.sim.set_encoder(0, 720)
+    rig.cycle(1)
+    assert not rig.get(e + "index-enable")
+    assert rig.get(e + "count") == 20
+    assert rig.get(e + "count-latched") == 700
+    assert rig.get(e + "rawcounts") == 720
+    rig.sim.pulse_index(0)                  # once only
+    rig.cycle(2)
+    assert rig.get(e + "count") == 20
+
+
+def test_encoder_follows_a_stepgen_axis(rig):
+    rig.sim.couple(0, 0, counts_per_step=2.0)
+    s = setup_stepgen(rig)
+    rig.set(s + "position-cmd", 1.0)        # 100 steps
+    rig.cycle(400)
+    assert rig.get("encoder.00.count") == pytest.approx(200, abs=2)
+
+
+# ------------------------------------------------------------------ pwm, LEDs
+
+def test_pwmgen_duty(rig):
+    p = "pwmgen.00."
+    rig.set(p + "scale", 10.0)
+    rig.set(p + "value", 5.0)
+    rig.cycle(2)
+    assert rig.sim.pwm_duty(0) == 0         # not enabled
+    rig.set(p + "enable", 1)
+    rig.cycle(2)
+    assert rig.sim.pwm_duty(0) == pytest.approx(0.5, abs=1e-3)
+    rig.set(p + "value", 20.0)              # clamped to 100 %
+    rig.cycle(2)
+    assert rig.sim.pwm_duty(0) == pytest.approx(1.0)
+    rig.set(p + "value", -2.5)              # magnitude, direction apart
+    rig.cycle(2)
+    assert rig.sim.pwm_duty(0) == pytest.approx(0.25, abs=1e-3)
+
+
+def test_leds(rig):
+    rig.set("led.CR01", 1)
+    rig.set("led.CR03", 1)
+    rig.cycle(2)
+    assert rig.sim.leds == (1 << 31) | (1 << 29)
+
+
+# ------------------------------------------------------------------ packets
+
+def test_lost_replies_raise_packet_error(rig):
+    rig.set("packet-read-timeout", 20_000_000)
+    rig.cycle(3)
+    assert not rig.get("packet-error") and rig.get("packet-error-level") == 0
+    rig.sim.faults.drop(next=2)
+    rig.cycle(1)
+    assert rig.get("packet-error") and rig.get("packet-error-level") == 2
+    rig.cycle(1)
+    assert rig.get("packet-error-level") == 4
+    assert rig.get("packet-error-total") == 2
+    rig.cycle(1)                            # good again: decreases by 1
+    assert not rig.get("packet-error") and rig.get("packet-error-level") == 3
+    rig.cycle(5)
+    assert rig.get("packet-error-level") == 0
+    assert not rig.get("packet-error-exceeded") and not rig.get("io_error")
+
+
+def test_late_and_short_replies_are_errors(rig):
+    rig.set("packet-read-timeout", 20_000_000)
+    rig.cycle(2)
+    rig.sim.faults.truncate(next=1)
+    rig.cycle(1)
+    assert rig.get("packet-error")
+    rig.sim.faults.delay(0.05, next=1)      # later than the timeout
+    rig.cycle(1)
+    assert rig.get("packet-error")
+    time.sleep(0.1)                         # the late reply arrives...
+    rig.sim.set_encoder(0, 42)
+    rig.cycle(1)                            # ...and is not taken for this one
+    assert not rig.get("packet-error")
+    assert rig.get("encoder.00.count") == 42
+
+
+def test_past_the_limit_the_board_stops(rig, capfd):
+    rig.set("packet-read-timeout", 10_000_000)
+    rig.set("gpio.040.is_output", 1)
+    rig.cycle(2)
+    rig.sim.faults.drop(probability=1.0)
+    for _ in range(5):                      # 5 x 2 reaches the limit 10
+        rig.cycle(1)
+    assert rig.get("packet-error-exceeded") and rig.get("io_error")
+    assert "reached the limit 10" in capfd.readouterr().err
+    before = rig.sim.stats.requests
+    rig.cycle(3)                            # stopped: no traffic at all
+    assert rig.sim.stats.requests == before
+    rig.sim.faults.clear()
+    rig.set("io_error", 0)                  # the user resets it
+    rig.cycle(2)
+    assert rig.get("packet-error-level") == 0 and not rig.get("io_error")
+    assert rig.sim.stats.requests > before
+
+
+def test_card_unplugged_and_back(rig):
+    rig.set("packet-read-timeout", 10_000_000)
+    rig.set("gpio.040.is_output", 1)
+    rig.set("gpio.040.out", 0)
+    s = setup_stepgen(rig)
+    rig.set(s + "position-cmd", 0.2)
+    rig.cycle(100)
+    assert rig.sim.is_output(40) and not rig.sim.pin(40)
+    rig.sim.go_away()                       # comes back in power-on state
+    rig.cycle(6)
+    assert rig.get("io_error")
+    rig.sim.come_back()
+    rig.cycle(2)
+    assert rig.get("io_error")              # stays stopped until reset
+    assert not rig.sim.is_output(40)
+    rig.set("io_error", 0)
+    rig.cycle(3)
+    assert rig.sim.is_output(40) and not rig.sim.pin(40)    # set up again
+    rig.set(s + "position-cmd", 0.5)
+    rig.cycle(200)
+    assert rig.get(s + "position-fb") == pytest.approx(0.5, abs=0.01)
+
+
+def test_read_request_then_read(hal, sim):
+    rig = load(hal, sim, CONFIG, functs=("read-request", "read", "write"))
+    rig.cycle(3)
+    sim.set_encoder(0, 77)
+    rig.cycle(1)
+    assert rig.get("encoder.00.count") == 77
+    assert rig.get("packet-error-level") == 0
+
+
+def test_the_7i92(hal, sim_7i92):
+    rig = load(hal, sim_7i92, "num_encoders=1 num_stepgens=5", board="7i92")
+    s = setup_stepgen(rig, n=4)
+    rig.set(s + "position-cmd", 0.3)
+    rig.cycle(300)
+    assert sim_7i92.axis_position(4) == pytest.approx(30, abs=1)
+    assert not hal.pins("hm2_7i92.0.pwmgen.*")

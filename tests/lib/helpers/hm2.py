@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import importlib
 import os
+import time
 from types import ModuleType
 
 import pytest
@@ -35,9 +36,19 @@ def hm2sim() -> ModuleType:
     pytest.skip("the simulated card (halsdk.drivers.hm2sim) is missing")
 
 
+#: the longest a cycle waits for the card to take the driver's packets
+SYNC_TIMEOUT = 0.02
+
+
 class Rig:
     """hm2_eth on a HAL thread against a simulated card whose clock moves
-    one period per cycle: :meth:`cycle` runs the thread once."""
+    one period per cycle: :meth:`cycle` runs the thread once.
+
+    The card serves its socket in a thread of its own, so a cycle waits
+    until the card has taken the cycle's two datagrams (the read request
+    and the write) before its clock moves on: the rates written in a cycle
+    then act during the next period, as on a card.  A cycle that sends
+    less (the board stopped, the watchdog bitten) waits SYNC_TIMEOUT."""
 
     def __init__(self, hal, sim, board: str) -> None:
         self.hal = hal
@@ -47,7 +58,12 @@ class Rig:
     def cycle(self, n: int = 1) -> None:
         for _ in range(n):
             self.sim.step(PERIOD * 1e-9)
+            before = self.sim.stats.requests
             self.hal.step(1)
+            deadline = time.monotonic() + SYNC_TIMEOUT
+            while (self.sim.stats.requests < before + 2
+                   and time.monotonic() < deadline):
+                time.sleep(0.0001)
 
     def get(self, name: str):
         return self.hal.getp(self.p + name)
