@@ -52,6 +52,7 @@ typedef int s32;
 #define LBP16_SPACE_HM2 0
 #define LBP16_SPACE_COMM 6
 #define LBP16_SPACE_INFO 7
+#define COMM_RX_COUNT 0x0008    /* status space: UDP datagrams received */
 
 #define HM2_PKT_MAX 1400        /* bytes of one UDP packet we build */
 
@@ -312,6 +313,9 @@ struct hm2_board {
     u8 rdbuf[HM2_PKT_MAX];
     struct lbp16_pkt wr;        /* rebuilt each write */
     int read_pending;           /* read_request sent, reply not taken */
+    int resync;                 /* take the card's count as it is */
+    u16 tx_count;               /* datagrams sent, as the card counts them
+                                   (LBP16 status space, COMM_RX_COUNT) */
     int force_write;            /* rewrite every setting: after load,
                                    a watchdog bite, a reconnection */
 
@@ -340,6 +344,7 @@ struct hm2_board {
 int lbp16_open(struct lbp16_link *l, const char *board_ip);
 void lbp16_close(struct lbp16_link *l);
 void lbp16_pkt_reset(struct lbp16_pkt *p);
+int lbp16_rx_count(struct lbp16_link *l, u16 *count);
 int lbp16_pkt_read(struct lbp16_pkt *p, int space, int size32, u16 addr,
                    int count);
 int lbp16_pkt_write32(struct lbp16_pkt *p, u16 addr, const u32 *data,
@@ -368,6 +373,7 @@ int hm2_assign_pins(struct hm2_board *b);
 int hm2_pin_aliases(struct hm2_board *b);
 
 /* board helpers (hm2_eth.c) */
+void hm2_send(struct hm2_board *b, const struct lbp16_pkt *p);
 int hm2_add_region(struct hm2_board *b, u16 addr, int count, u32 *dst);
 void hm2_queue_write(struct hm2_board *b, u16 addr, const u32 *data,
                      int count);

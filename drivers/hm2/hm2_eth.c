@@ -85,6 +85,18 @@ int hm2_read_regs(struct hm2_board *b, const struct hm2_module_desc *md,
     return 0;
 }
 
+/* send a packet of the thread functions: counted, as the card counts
+   the datagrams it receives; a failed send is a packet error */
+void hm2_send(struct hm2_board *b, const struct lbp16_pkt *p)
+{
+    if (p->len == 0)
+        return;
+    if (lbp16_send(&b->link, p) < 0)
+        b->cycle_error = 1;
+    else
+        b->tx_count++;
+}
+
 /* append to the write packet; a full packet is sent and a new begun */
 void hm2_queue_write(struct hm2_board *b, u16 addr, const u32 *data,
                      int count)
@@ -92,8 +104,7 @@ void hm2_queue_write(struct hm2_board *b, u16 addr, const u32 *data,
     while (count > 0) {
         int n = count > 64 ? 64 : count;
         if (lbp16_pkt_write32(&b->wr, addr, data, n) < 0) {
-            if (lbp16_send(&b->link, &b->wr) < 0)
-                b->cycle_error = 1;
+            hm2_send(b, &b->wr);
             lbp16_pkt_reset(&b->wr);
             if (lbp16_pkt_write32(&b->wr, addr, data, n) < 0)
                 return;
@@ -201,6 +212,7 @@ static int stopped(struct hm2_board *b)
         *b->packet_error = 0;
         b->read_pending = 0;
         b->force_write = 1;
+        b->resync = 1;
         HM2_ERR(b, "io_error reset: resuming");
     }
     return 0;
@@ -211,8 +223,7 @@ static int stopped(struct hm2_board *b)
 static void send_read_request(struct hm2_board *b)
 {
     lbp16_drain(&b->link);          /* late answers of earlier cycles */
-    if (lbp16_send(&b->link, &b->rdreq) < 0)
-        b->cycle_error = 1;
+    hm2_send(b, &b->rdreq);
     b->read_pending = 1;
 }
 
@@ -241,6 +252,15 @@ static void hm2_read(void *arg, long period)
     if (r < 0) {
         b->cycle_error = 1;
     } else {
+        /* the card's count of datagrams received ends the answer: a
+           lost write (or request) shows as a difference */
+        u16 rx = (u16)(b->rdbuf[r - 2] | (b->rdbuf[r - 1] << 8));
+        if (rx != b->tx_count) {
+            if (!b->resync)
+                b->cycle_error = 1;
+            b->tx_count = rx;
+        }
+        b->resync = 0;
         for (i = 0; i < b->num_regions; i++) {
             struct hm2_region *rg = &b->region[i];
             int k;
@@ -270,8 +290,7 @@ static void hm2_write(void *arg, long period)
         hm2_pwmgen_prepare(b);
         hm2_led_prepare(b);
     }
-    if (lbp16_send(&b->link, &b->wr) < 0)
-        b->cycle_error = 1;
+    hm2_send(b, &b->wr);
     b->force_write = 0;
 }
 
@@ -436,6 +455,13 @@ static int load_board(struct hm2_board *b, int i)
         r = hm2_led_setup(b, comp_id);
     if (!r)
         r = hm2_pin_aliases(b);
+    if (!r && lbp16_pkt_read(&b->rdreq, LBP16_SPACE_COMM, 0, COMM_RX_COUNT,
+                             1) < 0) {
+        HM2_ERR(b, "too many registers to read in one packet");
+        r = -ENOSPC;
+    }
+    if (!r)
+        r = lbp16_rx_count(&b->link, &b->tx_count);
     if (r < 0)
         return r;
     b->force_write = 1;

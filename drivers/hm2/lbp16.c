@@ -254,6 +254,22 @@ int lbp16_write32(struct lbp16_link *l, u16 addr, const u32 *src, int count)
     return lbp16_send(l, &p);
 }
 
+/* load time: the count of datagrams the card has received (this one
+   included) */
+int lbp16_rx_count(struct lbp16_link *l, u16 *count)
+{
+    struct lbp16_pkt p;
+    u8 buf[HM2_PKT_MAX];
+    int r;
+    lbp16_pkt_reset(&p);
+    lbp16_pkt_read(&p, LBP16_SPACE_COMM, 0, COMM_RX_COUNT, 1);
+    r = lbp16_transact(l, &p, buf, LOAD_TIMEOUT_NS, LOAD_TRIES);
+    if (r < 0)
+        return r;
+    *count = (u16)(buf[0] | (buf[1] << 8));
+    return 0;
+}
+
 /* the card's name from the board-information space ("7I96S"), as a
    NUL-terminated string */
 int lbp16_board_name(struct lbp16_link *l, char *name, int len)

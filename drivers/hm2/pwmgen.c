@@ -3,7 +3,8 @@
  *
  * Registers: 0 value (per instance: duty in bits 16..30 scaled to the
  * PWM width, bit 31 the direction), 1 mode (per instance: bits 0..1 the
- * width, 9 + n bits; bits 3..4 the output type - 1; bit 5 PDM), 2 the
+ * width, 9 + n bits; bits 3..4 the output type - 1; bit 5 double
+ * buffered, as the reference sets it), 2 the
  * PWM master rate (one for the module), 3 the PDM master rate, 4 enable
  * (bit n: instance n enabled).
  *
@@ -19,6 +20,7 @@
 
 enum { R_VALUE, R_MODE, R_PWM_RATE, R_PDM_RATE, R_ENABLE };
 #define PWM_BITS 12
+#define MODE_DOUBLE_BUFFER (1u << 5)
 
 #define PIN(kind, dir, field, suffix)                                      \
     if (!r)                                                                \
@@ -96,8 +98,7 @@ void hm2_pwmgen_prepare(struct hm2_board *b)
             dc = (dc + 1.0) / 2.0;
         if (type < 1 || type > 4)
             type = 1;
-        mode = (PWM_BITS - 9) | ((u32)(type - 1) << 3)
-            | (type == 3 ? (1u << 5) : 0);
+        mode = (PWM_BITS - 9) | ((u32)(type - 1) << 3) | MODE_DOUBLE_BUFFER;
         mag = (u32)lrint(fabs(dc) * ((1 << PWM_BITS) - 1));
         pw->value[i] = (mag << 16) | (dc < 0 ? 0x80000000u : 0);
         if (*p->enable)

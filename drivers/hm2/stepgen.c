@@ -5,7 +5,8 @@
  * every clock, one step per 2^32), 1 accumulator (read: steps in 16.16
  * fixed point), 2 mode (0 step/dir, 1 up/down, 2 quadrature, 3 table),
  * 3 direction setup, 4 direction hold, 5 step length, 6 step space
- * (times in ticks of the module's clock), 8 table width.
+ * (times in ticks of the module's clock), 7 table data, 8 table width,
+ * 9 the master DDS of the module (written all ones: the full clock).
  *
  * The card only generates a rate; the position loop is here.  In
  * position mode, each write computes the velocity that reaches the
@@ -26,7 +27,7 @@
 #define TIMING_MAX 0x3fff         /* ticks: the timing registers' width */
 
 enum { R_RATE, R_ACCUM, R_MODE, R_DIRSETUP, R_DIRHOLD, R_STEPLEN,
-       R_STEPSPACE, R_TABLE, R_TABLEWIDTH };
+       R_STEPSPACE, R_TABLE, R_TABLEWIDTH, R_MASTER_DDS };
 
 #define PIN(kind, dir, field, suffix)                                      \
     if (!r)                                                                \
@@ -230,6 +231,10 @@ void hm2_stepgen_prepare(struct hm2_board *b, long period)
         hm2_write_regs(b, sg->md, R_STEPSPACE, sg->num, stepspace);
         if (sg->md->num_registers > R_TABLEWIDTH)
             hm2_write_regs(b, sg->md, R_TABLEWIDTH, sg->num, width);
+        if (sg->md->num_registers > R_MASTER_DDS) {
+            u32 dds = 0xffffffffu;
+            hm2_queue_write(b, hm2_reg_addr(sg->md, R_MASTER_DDS), &dds, 1);
+        }
         for (i = 0; i < sg->num; i++) {
             struct hm2_stepgen_inst *s = &sg->inst[i];
             s->w_steplen = steplen[i];

@@ -488,3 +488,43 @@ def test_the_7i92(hal, sim_7i92):
     rig.cycle(300)
     assert sim_7i92.axis_position(4) == pytest.approx(30, abs=1)
     assert not hal.pins("hm2_7i92.0.pwmgen.*")
+
+
+def test_a_lost_datagram_shows_in_the_card_count(rig):
+    """The read answer ends with the card's count of datagrams received;
+    one the driver did not send (or one it sent that was lost) makes the
+    counts differ: a packet error, then the counts agree again."""
+    rig.cycle(3)
+    assert rig.get("packet-error-total") == 0
+    s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    try:
+        # a write of the LED register: no answer, but counted
+        s.sendto(bytes.fromhex("81c2000200000000"), ("127.0.0.1",
+                                                      rig.sim.port))
+    finally:
+        s.close()
+    time.sleep(0.05)
+    rig.cycle(1)
+    assert rig.get("packet-error") and rig.get("packet-error-total") == 1
+    rig.cycle(2)
+    assert not rig.get("packet-error") and rig.get("packet-error-total") == 1
+
+
+def test_a_hal_file_as_the_reference_configs_write_it(hal, sim, tmp_path):
+    from halsdk import halcmd
+    path = tmp_path / "mesa.hal"
+    path.write_text(
+        "loadrt hostmot2\n"
+        f'loadrt hm2_eth board_ip="127.0.0.1:{sim.port}" '
+        'config="num_encoders=1 num_pwmgens=1 num_stepgens=3"\n'
+        "loadrt threads name1=servo-thread period1=1000000\n"
+        "addf hm2_7i96s.0.read servo-thread\n"
+        "addf hm2_7i96s.0.write servo-thread\n"
+        "setp hm2_7i96s.0.watchdog.timeout_ns 20000000\n"
+        "setp hm2_7i96s.0.stepgen.00.position-scale 200\n"
+        "net x-pos-cmd hm2_7i96s.0.stepgen.00.position-cmd\n",
+        encoding="utf-8")
+    assert halcmd.source(hal, str(path)) == 0
+    assert hal.getp("hm2_7i96s.0.stepgen.00.position-scale") == 200
+    assert hal.pins("hm2_7i96s.0.stepgen.02.*")
+    assert not hal.pins("hm2_7i96s.0.stepgen.03.*")

@@ -85,3 +85,57 @@ def load(hal, sim, config: str = "", board: str = "7i96s",
         hal.addf(rig.p + f, "servo")
     rig.set("packet-read-timeout", READ_TIMEOUT)
     return rig
+
+
+# --------------------------------------------------------------- listings
+
+#: the goldens while they live on another branch (HM2_GOLDENS: a folder
+#: holding <board>/show-pin.txt ...)
+_GOLDEN_FOLDERS = [os.environ.get("HM2_GOLDENS", ""),
+                   "/work/wt-hm2sim/tests/data/hm2"]
+
+
+def golden_folder(board: str) -> str:
+    """tests/data/hm2/<board>: the reference's listings against hm2-sim."""
+    from helpers import repo_path
+    here = str(repo_path("tests", "data", "hm2"))
+    for folder in [here] + _GOLDEN_FOLDERS:
+        path = os.path.join(folder, board)
+        if folder and os.path.isfile(os.path.join(path, "show-pin.txt")):
+            return path
+    pytest.skip(f"the reference's listings of the {board} are missing")
+
+
+#: values that depend on the run, not on the driver: the functions' and
+#: the thread's times, and the I/O error state of the reference's run
+RUNTIME_PARAMS = (".tmax", ".io_error")
+
+
+def listing(lines: list[str]) -> dict[tuple[str, str], tuple[str, ...]]:
+    """A ``show pin``/``show param``/``show funct`` listing, normalised:
+    (section, name) -> the columns that describe the object.  Dropped:
+    the owner column (component ids differ), pin values (the state of a
+    run), the values of RUNTIME_PARAMS, and the code and argument
+    addresses of functions."""
+    out: dict[tuple[str, str], tuple[str, ...]] = {}
+    section = None
+    for line in lines:
+        if line.startswith("Component Pins"):
+            section = "pin"
+        elif line.startswith("Parameters"):
+            section = "param"
+        elif line.startswith("Exported Functions"):
+            section = "funct"
+        elif not line.strip() or line.startswith("Owner") or not section:
+            continue
+        else:
+            f = line.split()
+            name = f[-1]
+            if section == "funct":
+                out[(section, name)] = (f[3], f[4])         # FP, users
+            elif section == "pin":
+                out[(section, name)] = (f[1], f[2])         # type, dir
+            else:
+                value = "" if name.endswith(RUNTIME_PARAMS) else f[3]
+                out[(section, name)] = (f[1], f[2], value)
+    return out
