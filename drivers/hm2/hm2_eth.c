@@ -6,7 +6,9 @@
  *
  * Modparams as the reference's: board_ip (one per board; "ip:port"
  * reaches a card, such as the simulated one, on another UDP port than
- * 27181), config (one hostmot2 config string per board) and debug.
+ * 27181), config (one hostmot2 config string per board), board_mac
+ * (accepted; the reference makes static ARP entries with it, halsdk
+ * does not) and debug.
  *
  * Per board it makes the functions hm2_<type>.<n>.read, .write and
  * .read-request and the packet-error pins and params of hm2_eth(9).
@@ -36,6 +38,10 @@ RTAPI_MP_ARRAY_STRING(board_ip, HM2_MAX_BOARDS,
 static char *config[HM2_MAX_BOARDS] = {0};
 RTAPI_MP_ARRAY_STRING(config, HM2_MAX_BOARDS,
                       "hostmot2 config strings, one per board");
+static char *board_mac[HM2_MAX_BOARDS] = {0};
+RTAPI_MP_ARRAY_STRING(board_mac, HM2_MAX_BOARDS,
+                      "MAC address of the board(s) (accepted, unused: "
+                      "halsdk sets no ARP entry)");
 static int debug = 0;
 RTAPI_MP_INT(debug, "print the IDROM and the pin use at load");
 
@@ -213,6 +219,10 @@ static int stopped(struct hm2_board *b)
         b->read_pending = 0;
         b->force_write = 1;
         b->resync = 1;
+        /* the watchdog bit while the board was stopped: resuming is the
+           user's reset of it too */
+        if (b->wd.present && !*b->wd.has_bit)
+            b->wd.was_bit = 1;
         HM2_ERR(b, "io_error reset: resuming");
     }
     return 0;

@@ -440,13 +440,18 @@ def test_past_the_limit_the_board_stops(rig, capfd):
     assert rig.get("packet-error-exceeded") and rig.get("io_error")
     assert "reached the limit 10" in capfd.readouterr().err
     before = rig.sim.stats.requests
-    rig.cycle(3)                            # stopped: no traffic at all
+    rig.cycle(8)                            # stopped: no traffic at all
     assert rig.sim.stats.requests == before
     rig.sim.faults.clear()
+    assert rig.sim.watchdog_bitten          # no writes: the card bit
+    assert not rig.sim.is_output(40)
     rig.set("io_error", 0)                  # the user resets it
     rig.cycle(2)
     assert rig.get("packet-error-level") == 0 and not rig.get("io_error")
     assert rig.sim.stats.requests > before
+    # resuming resets the watchdog too and sets the card up again
+    assert not rig.get("watchdog.has_bit") and not rig.sim.watchdog_bitten
+    assert rig.sim.is_output(40)
 
 
 def test_card_unplugged_and_back(rig):
