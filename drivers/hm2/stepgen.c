@@ -217,7 +217,7 @@ void hm2_stepgen_prepare(struct hm2_board *b, long period)
         dirsetup[i] = ticks(s->dirsetup, sg->clock_hz);
         dirhold[i] = ticks(s->dirhold, sg->clock_hz);
         mode[i] = s->step_type > 3 ? 3 : s->step_type;
-        width[i] = s->step_type > 3 ? s->step_type : 0;
+        width[i] = s->step_type >= 3 ? s->step_type : 0;
         if (steplen[i] != s->w_steplen || stepspace[i] != s->w_stepspace
             || dirsetup[i] != s->w_dirsetup || dirhold[i] != s->w_dirhold
             || mode[i] != s->w_mode || !s->timing_written)

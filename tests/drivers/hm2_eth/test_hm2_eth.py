@@ -271,18 +271,21 @@ def test_stepgen_disable_stops_at_once(rig):
     assert rig.get(s + "velocity-fb") == 0
 
 
-def test_stepgen_timings_and_step_type(rig):
+@pytest.mark.parametrize("step_type, mode", [(0, 0), (1, 1), (2, 2),
+                                              (3, 3), (6, 3)])
+def test_stepgen_timings_and_step_type(rig, step_type, mode):
     s = "stepgen.03."
     rig.set(s + "steplen", 5000)            # ns; 100 MHz clock: 500 ticks
     rig.set(s + "stepspace", 1000)
     rig.set(s + "dirsetup", 30)             # rounded up to whole ticks
     rig.set(s + "dirhold", 0)
-    rig.set(s + "step_type", 2)
+    rig.set(s + "step_type", step_type)     # 3 and more: table of that size
     rig.cycle(2)
     reg = rig.sim.stepgen(3)
     assert (reg["step_len"], reg["step_space"]) == (500, 100)
     assert (reg["dir_setup"], reg["dir_hold"]) == (3, 0)
-    assert reg["mode"] == 2
+    assert reg["mode"] == mode
+    assert rig.sim.stepgen(2)["step_len"] == 0x3FFF     # the default
 
 
 def test_stepgen_position_reset(rig):
