@@ -14,6 +14,8 @@
  * maxaccel: the velocity that closes the error in one period, or less
  * when the remaining distance is only enough to decelerate at maxaccel.
  * In velocity mode it follows velocity-cmd within the same limits.
+ * Within half a step of the command it only follows the command's own
+ * velocity, so a standing axis does not dither around a step edge.
  * maxvel 0 means the fastest the step timings allow; maxaccel 0 means no
  * acceleration limit.  position-fb comes from the accumulator, with
  * finer than step resolution.
@@ -158,7 +160,9 @@ static double step_velocity(struct hm2_stepgen_inst *s, double dt,
         *s->dbg_ff_vel = ff;
         *s->dbg_err_at_match = err;
         s->old_pos_cmd = cmd;
-        if (a > 0) {
+        if (fabs(err) < 0.5 / fabs(scale))
+            fix = 0.0;      /* within half a step: no dither around it */
+        else if (a > 0) {
             /* no faster than what still stops at the target, relative
                to the moving command */
             double stop = sqrt(2.0 * a * fabs(err));

@@ -536,3 +536,40 @@ def test_a_hal_file_as_the_reference_configs_write_it(hal, sim, tmp_path):
     assert hal.getp("hm2_7i96s.0.stepgen.00.position-scale") == 200
     assert hal.pins("hm2_7i96s.0.stepgen.02.*")
     assert not hal.pins("hm2_7i96s.0.stepgen.03.*")
+
+
+def test_a_real_time_thread(hal):
+    """The servo thread running on its own against the card on the wall
+    clock: the exchange works outside of stepped time too."""
+    from helpers.hm2 import hm2sim
+    with hm2sim().Hm2Sim("7i96s", port=0) as sim:
+        hal.loadrt("hostmot2")
+        hal.loadrt("hm2_eth", f"board_ip=127.0.0.1:{sim.port}",
+                   'config="num_encoders=0 num_pwmgens=0 num_stepgens=1"')
+        hal.newthread("servo", 2_000_000)
+        p = "hm2_7i96s.0."
+        hal.addf(p + "read", "servo")
+        hal.addf(p + "write", "servo")
+        # a shared test machine is no realtime system: generous limits
+        hal.setp(p + "packet-read-timeout", 90)
+        hal.setp(p + "packet-error-limit", 100_000)
+        hal.setp(p + "watchdog.timeout_ns", 200_000_000)
+        s = p + "stepgen.00."
+        hal.setp(s + "position-scale", 100.0)
+        hal.setp(s + "maxvel", 10.0)
+        hal.setp(s + "maxaccel", 100.0)
+        for t in ("steplen", "stepspace", "dirsetup", "dirhold"):
+            hal.setp(s + t, 1000)
+        hal.setp(s + "enable", 1)
+        hal.setp(s + "position-cmd", 0.5)
+        hal.start(realtime=False)
+        try:
+            deadline = time.monotonic() + 10
+            while (abs(hal.getp(s + "position-fb") - 0.5) > 0.01
+                   and time.monotonic() < deadline):
+                time.sleep(0.02)
+        finally:
+            hal.stop()
+        assert hal.getp(s + "position-fb") == pytest.approx(0.5, abs=0.01)
+        assert sim.axis_position(0) == pytest.approx(50, abs=1)
+        assert not hal.getp(p + "io_error")
