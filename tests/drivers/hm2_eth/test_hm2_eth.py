@@ -573,3 +573,23 @@ def test_a_real_time_thread(hal):
         assert hal.getp(s + "position-fb") == pytest.approx(0.5, abs=0.01)
         assert sim.axis_position(0) == pytest.approx(50, abs=1)
         assert not hal.getp(p + "io_error")
+
+
+def test_two_boards(hal, sim, sim_7i92):
+    from helpers.hm2 import hm2sim
+    with hm2sim().Hm2Sim("7i96s", port=0, realtime=False) as sim2:
+        hal.loadrt("hm2_eth",
+                   f"board_ip=127.0.0.1:{sim.port},127.0.0.1:{sim_7i92.port},"
+                   f"127.0.0.1:{sim2.port}",
+                   'config="num_stepgens=1,num_stepgens=2,num_stepgens=3"')
+        counts = {b: len(hal.pins(f"{b}.stepgen.*.position-cmd"))
+                  for b in ("hm2_7i96s.0", "hm2_7i92.0", "hm2_7i96s.1")}
+        assert counts == {"hm2_7i96s.0": 1, "hm2_7i92.0": 2, "hm2_7i96s.1": 3}
+        hal.newthread("servo", PERIOD)
+        hal.addf("hm2_7i96s.1.read", "servo")
+        hal.addf("hm2_7i96s.1.write", "servo")
+        hal.setp("hm2_7i96s.1.packet-read-timeout", 200_000_000)
+        hal.setp("hm2_7i96s.1.gpio.040.is_output", 1)
+        hal.setp("hm2_7i96s.1.gpio.040.out", 0)
+        hal.step(2)
+        assert sim2.is_output(40) and not sim.is_output(40)
