@@ -69,8 +69,8 @@ def test_config_selects_instances(hal, sim):
 
 
 @pytest.mark.parametrize("config, text", [
-    ("num_encoders=2", "num_encoders=2, but the firmware has 1"),
-    ("num_stepgens=6", "num_stepgens=6, but the firmware has 5"),
+    ("num_encoders=2", "num_encoders=2, but only 1 are available"),
+    ("num_stepgens=6", "num_stepgens=6, but only 5 are available"),
     ("num_frobs=1", 'invalid token in config string: "num_frobs=1"'),
     ("num_pwmgens=x", "num_pwmgens=x is not a number"),
 ])

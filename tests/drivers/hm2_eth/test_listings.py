@@ -10,12 +10,14 @@ and each function's FP flag and users are."""
 
 from __future__ import annotations
 
+import os
 import re
 
 import pytest
 from helpers.hm2 import golden_folder, hm2sim, listing
 
 from halsdk import halcmd
+from halsdk.errors import HalError
 
 RUN_ONLY = ("start", "stop", "loadusr", "show")
 
@@ -77,3 +79,36 @@ def test_listing_normalisation():
         ("param", "hm2_7i92.0.read.tmax"): ("s32", "RW", ""),
         ("funct", "hm2_7i92.0.read"): ("YES", "1"),
     }
+
+
+def reference_configs(folder: str) -> list[tuple[str, bool]]:
+    """The config strings the reference was loaded with (configs.txt of
+    the goldens) and whether it accepted each."""
+    out = []
+    with open(f"{folder}/configs.txt", encoding="utf-8") as f:
+        for line in f:
+            m = re.match(r'=== config="(.*)" \(exit status (\d+)\)', line)
+            if m:
+                out.append((m.group(1), m.group(2) == "0"))
+    return out
+
+
+@pytest.mark.parametrize("board", ["7i96s", "7i92"])
+def test_config_strings_accepted_as_the_reference(hal, board):
+    """Each config string of the goldens loads with hm2_eth exactly when
+    it loaded with the reference's."""
+    folder = golden_folder(board)
+    cases = reference_configs(folder) if os.path.isfile(
+        f"{folder}/configs.txt") else []
+    if not cases:
+        pytest.skip("the goldens have no configs.txt")
+    with hm2sim().Hm2Sim(board, port=0, realtime=False) as sim:
+        for config, accepted in cases:
+            try:
+                hal.loadrt("hm2_eth", f"board_ip=127.0.0.1:{sim.port}",
+                           f'config="{config}"')
+            except HalError as exc:
+                assert not accepted, f"{config!r} refused: {exc}"
+            else:
+                assert accepted, f"{config!r} accepted"
+                hal.unloadrt("hm2_eth")

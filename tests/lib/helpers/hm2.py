@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import importlib
 import os
-import time
 from types import ModuleType
 
 import pytest
@@ -60,10 +59,7 @@ class Rig:
             self.sim.step(PERIOD * 1e-9)
             before = self.sim.stats.requests
             self.hal.step(1)
-            deadline = time.monotonic() + SYNC_TIMEOUT
-            while (self.sim.stats.requests < before + 2
-                   and time.monotonic() < deadline):
-                time.sleep(0.0001)
+            self.sim.wait_requests(before + 2, SYNC_TIMEOUT)
 
     def get(self, name: str):
         return self.hal.getp(self.p + name)
