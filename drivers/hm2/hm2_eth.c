@@ -322,22 +322,20 @@ static void lower(char *dst, const char *src, int len)
 static void print_idrom(struct hm2_board *b)
 {
     int i;
-    rtapi_print_msg(RTAPI_MSG_INFO, "%s: IDROM type %u, %s, %u ports of %u "
-                    "pins, clocks %u/%u Hz\n", b->name, b->idrom.idrom_type,
-                    b->idrom.board_name, b->idrom.io_ports,
-                    b->idrom.port_width, b->idrom.clock_low,
-                    b->idrom.clock_high);
+    rtapi_print("%s: IDROM type %u, %s, %u ports of %u pins, clocks %u/%u "
+                "Hz\n", b->name, b->idrom.idrom_type, b->idrom.board_name,
+                b->idrom.io_ports, b->idrom.port_width, b->idrom.clock_low,
+                b->idrom.clock_high);
     for (i = 0; i < b->num_md; i++)
-        rtapi_print_msg(RTAPI_MSG_INFO, "%s: module gtag %d v%d: %d at "
-                        "0x%04x, %d registers\n", b->name, b->md[i].gtag,
-                        b->md[i].version, b->md[i].instances,
-                        b->md[i].base_address, b->md[i].num_registers);
+        rtapi_print("%s: module gtag %d v%d: %d at 0x%04x, %d registers\n",
+                    b->name, b->md[i].gtag, b->md[i].version,
+                    b->md[i].instances, b->md[i].base_address,
+                    b->md[i].num_registers);
     for (i = 0; i < b->num_pins; i++)
         if (b->pin[i].owner_gtag)
-            rtapi_print_msg(RTAPI_MSG_INFO, "%s: I/O pin %03d: gtag %d "
-                            "instance %d pin 0x%02x\n", b->name, i,
-                            b->pin[i].owner_gtag, b->pin[i].owner_inst,
-                            b->pin[i].sec_pin);
+            rtapi_print("%s: I/O pin %03d: gtag %d instance %d pin 0x%02x\n",
+                        b->name, i, b->pin[i].owner_gtag,
+                        b->pin[i].owner_inst, b->pin[i].sec_pin);
 }
 
 static int export_board(struct hm2_board *b)

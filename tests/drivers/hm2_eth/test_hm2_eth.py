@@ -593,3 +593,22 @@ def test_two_boards(hal, sim, sim_7i92):
         hal.setp("hm2_7i96s.1.gpio.040.out", 0)
         hal.step(2)
         assert sim2.is_output(40) and not sim.is_output(40)
+
+
+def test_module_output_inverted(rig):
+    """A module's output is inverted by the card (its output invert
+    register), through the param named after the module's pin."""
+    rig.cycle(2)
+    assert rig.sim.is_output(18) and not rig.sim.pin(18)    # direction
+    rig.set("stepgen.00.direction.invert_output", 1)
+    rig.cycle(2)
+    assert rig.sim.pin(18)
+    assert rig.hal.getp("hm2_7i96s.0.gpio.018.invert_output")   # the same
+
+
+def test_debug_prints_the_idrom(hal, sim, capfd):
+    hal.loadrt("hm2_eth", f"board_ip=127.0.0.1:{sim.port}", "debug=1",
+               'config="num_stepgens=2"')
+    err = capfd.readouterr().err
+    assert "IDROM type 3, MESA7I96" in err
+    assert "I/O pin 017: gtag 5 instance 0" in err
