@@ -9,8 +9,16 @@
  *
  * index-enable arms latch-on-index (once); the card clears that bit when
  * the index comes, and the latched count becomes count 0.
+ *
+ * Velocity comes from the card's timestamps: the counter register holds
+ * the time of the last count, the timestamp register (3) the time of the
+ * read, both counting at the module clock / (divider + 2), about 2 MHz
+ * (10 MHz with hires-timestamp).  A period with counts gives counts /
+ * time between the last counts; a period without gives at most one count
+ * over the time since the last one, and 0 after vel-timeout seconds.
  */
 #include <errno.h>
+#include <math.h>
 #include <string.h>
 
 #include "hm2.h"
@@ -95,13 +103,44 @@ int hm2_encoder_setup(struct hm2_board *b, int comp_id)
     r = hm2_read_regs(b, en->md, R_COUNTER, en->num, en->counter);
     if (!r)
         r = hm2_read_regs(b, en->md, R_LATCH, en->num, en->latch);
+    if (!r)
+        r = hm2_read_regs(b, en->md, R_TSCOUNT, 1, &en->tscount);
     return r;
+}
+
+static u32 tsdiv(struct hm2_encoder *en)
+{
+    u32 freq = *en->hires_timestamp ? 10000000u : 2000000u;
+    u32 div = en->clock_hz / freq;
+    return div < 2 ? 0 : div - 2;
+}
+
+/* counts/s from the timestamps (see above); delta counts this period */
+static double ts_velocity(struct hm2_encoder *en,
+                          struct hm2_encoder_inst *e, int delta,
+                          u16 change_ts, u16 tick, double ts_hz)
+{
+    double v = *e->velocity * (e->scale == 0.0 ? 1.0 : e->scale);
+    if (delta != 0) {
+        double span = e->age + (u16)(change_ts - en->last_tscount);
+        e->age = (u16)(tick - change_ts);
+        return span > 0 ? delta * ts_hz / span : v;
+    }
+    e->age += (u16)(tick - en->last_tscount);
+    if (e->age / ts_hz > e->vel_timeout)
+        return 0.0;
+    if (fabs(v) > ts_hz / e->age)       /* no count: at most 1 / age */
+        v = v > 0 ? ts_hz / e->age : -ts_hz / e->age;
+    return v;
 }
 
 void hm2_encoder_process(struct hm2_board *b, long period)
 {
     struct hm2_encoder *en = &b->enc;
+    u16 tick = (u16)en->tscount;
+    double ts_hz = (double)en->clock_hz / (en->w_tsdiv + 2);
     int i;
+    (void)period;
     for (i = 0; i < en->num; i++) {
         struct hm2_encoder_inst *e = &en->inst[i];
         u16 now = (u16)(en->counter[i] & 0xffff);
@@ -132,8 +171,10 @@ void hm2_encoder_process(struct hm2_board *b, long period)
         *e->rawcounts = (s32)e->total;
         *e->count = (s32)(e->total - e->zero);
         *e->position = (double)(e->total - e->zero) / scale;
-        if (e->primed && period > 0)
-            *e->velocity = delta / scale / (period * 1e-9);
+        if (e->primed && en->ts_primed)
+            *e->velocity = ts_velocity(en, e, delta,
+                                       (u16)(en->counter[i] >> 16), tick,
+                                       ts_hz) / scale;
         else
             *e->velocity = 0.0;
         *e->velocity_rpm = *e->velocity * 60.0;
@@ -144,6 +185,8 @@ void hm2_encoder_process(struct hm2_board *b, long period)
             && (latch & CTRL_QUAD_ERROR) != 0;
         e->primed = 1;
     }
+    en->last_tscount = tick;
+    en->ts_primed = en->num > 0;
 }
 
 void hm2_encoder_prepare(struct hm2_board *b)
@@ -163,6 +206,12 @@ void hm2_encoder_prepare(struct hm2_board *b)
     if (rate != en->w_rate || b->force_write) {
         hm2_queue_write(b, hm2_reg_addr(en->md, R_RATE), &rate, 1);
         en->w_rate = rate;
+    }
+    if (tsdiv(en) != en->w_tsdiv || b->force_write) {
+        u32 div = tsdiv(en);
+        hm2_queue_write(b, hm2_reg_addr(en->md, R_TSDIV), &div, 1);
+        en->w_tsdiv = div;
+        en->ts_primed = 0;          /* the next read starts again */
     }
     for (i = 0; i < en->num; i++) {
         struct hm2_encoder_inst *e = &en->inst[i];

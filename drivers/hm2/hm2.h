@@ -201,6 +201,7 @@ struct hm2_encoder_inst {
     u16 last;
     int primed;
     int index_armed;            /* latch-on-index written to the card */
+    double age;                 /* timestamp ticks since the last count */
     u32 ctrl_written;
 };
 
@@ -215,7 +216,10 @@ struct hm2_encoder {
     u32 clock_hz;
     hal_bit_t *hires_timestamp;
     hal_u32_t *sample_frequency;
-    u32 w_rate;
+    u32 w_rate, w_tsdiv;
+    u32 tscount;                /* read: the timestamp counter now */
+    u16 last_tscount;
+    int ts_primed;
     struct hm2_encoder_inst *inst;
 };
 

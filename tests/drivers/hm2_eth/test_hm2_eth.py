@@ -612,3 +612,35 @@ def test_debug_prints_the_idrom(hal, sim, capfd):
     err = capfd.readouterr().err
     assert "IDROM type 3, MESA7I96" in err
     assert "I/O pin 017: gtag 5 instance 0" in err
+
+
+def test_encoder_velocity_at_low_speed(rig):
+    """50 counts/s is one count every 20 periods: from the card's
+    timestamps the velocity stays near 50 between counts, then decays as
+    1 / time since the last count once it stops, and is 0 after
+    vel-timeout."""
+    e = "encoder.00."
+    rig.cycle(2)
+    rig.sim.set_encoder_velocity(0, 50.0)
+    rig.cycle(100)
+    vels = []
+    for _ in range(200):
+        rig.cycle(1)
+        vels.append(rig.get(e + "velocity"))
+    assert min(vels) > 40 and max(vels) < 51
+    rig.sim.set_encoder_velocity(0, 0.0)
+    rig.cycle(100)                          # 0.1 s after the last count
+    assert 5 < rig.get(e + "velocity") <= 10.5
+    rig.set(e + "vel-timeout", 0.2)
+    rig.cycle(150)
+    assert rig.get(e + "velocity") == 0
+
+
+def test_encoder_hires_timestamp(rig):
+    rig.cycle(2)
+    rig.sim.set_encoder_velocity(0, -3000.0)
+    rig.cycle(20)
+    assert rig.get("encoder.00.velocity") == pytest.approx(-3000, rel=0.01)
+    rig.set("encoder.hires-timestamp", 1)   # 10 MHz: the divider changes
+    rig.cycle(20)
+    assert rig.get("encoder.00.velocity") == pytest.approx(-3000, rel=0.01)
