@@ -644,3 +644,17 @@ def test_encoder_hires_timestamp(rig):
     rig.set("encoder.hires-timestamp", 1)   # 10 MHz: the divider changes
     rig.cycle(20)
     assert rig.get("encoder.00.velocity") == pytest.approx(-3000, rel=0.01)
+
+
+def test_lost_datagrams_on_the_way_to_the_card(rig):
+    """A lost read request times out; a lost write is seen in the next
+    cycle, from the card's count of datagrams: two errors."""
+    rig.set("packet-read-timeout", 20_000_000)
+    rig.cycle(3)
+    rig.sim.faults.lose(next=2)             # this cycle's request and write
+    rig.cycle(1)
+    assert rig.get("packet-error") and rig.get("packet-error-total") == 1
+    rig.cycle(1)
+    assert rig.get("packet-error") and rig.get("packet-error-total") == 2
+    rig.cycle(1)
+    assert not rig.get("packet-error") and rig.get("packet-error-total") == 2
