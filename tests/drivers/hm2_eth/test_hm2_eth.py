@@ -658,3 +658,20 @@ def test_lost_datagrams_on_the_way_to_the_card(rig):
     assert rig.get("packet-error") and rig.get("packet-error-total") == 2
     rig.cycle(1)
     assert not rig.get("packet-error") and rig.get("packet-error-total") == 2
+
+
+def test_a_card_left_bitten_starts_clean(hal, sim):
+    rig = load(hal, sim, CONFIG)
+    rig.cycle(5)
+    sim.step(0.02)                          # the HAL stops: the card bites
+    assert sim.watchdog_bitten
+    hal.unloadrt("hm2_eth")                 # ... and a new run loads
+    hal.loadrt("hm2_eth", f"board_ip=127.0.0.1:{sim.port}",
+               f'config="{CONFIG}"')
+    assert not sim.watchdog_bitten
+    hal.addf(rig.p + "read", "servo")
+    hal.addf(rig.p + "write", "servo")
+    rig.set("packet-read-timeout", 200_000_000)
+    rig.set("gpio.040.is_output", 1)
+    rig.cycle(3)
+    assert not rig.get("watchdog.has_bit") and sim.is_output(40)
