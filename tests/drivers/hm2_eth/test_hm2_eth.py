@@ -675,3 +675,13 @@ def test_a_card_left_bitten_starts_clean(hal, sim):
     rig.set("gpio.040.is_output", 1)
     rig.cycle(3)
     assert not rig.get("watchdog.has_bit") and sim.is_output(40)
+
+
+def test_duplicated_replies_are_not_taken_twice(rig):
+    rig.cycle(2)
+    rig.sim.faults.duplicate(next=3)
+    for counts in (5, 9, 14, 20):
+        rig.sim.set_encoder(0, counts)
+        rig.cycle(1)
+        assert rig.get("encoder.00.count") == counts
+    assert rig.get("packet-error-total") == 0
