@@ -565,7 +565,10 @@ def test_a_real_time_thread(hal):
         hal.start(realtime=False)
         try:
             deadline = time.monotonic() + 10
-            while (abs(hal.getp(s + "position-fb") - 0.5) > 0.01
+            # at rest there: the card keeps its last rate after the stop
+            # until the watchdog bites
+            while ((abs(hal.getp(s + "position-fb") - 0.5) > 0.01
+                    or abs(hal.getp(s + "velocity-fb")) > 1e-6)
                    and time.monotonic() < deadline):
                 time.sleep(0.02)
         finally:
