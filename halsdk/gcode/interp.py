@@ -45,8 +45,18 @@ CANNED = (730, 810, 820, 830, 840, 850, 860, 880, 890)
 UNSUPPORTED_MOTION = {760: "G76", 870: "G87"}
 
 
+#: Letters every block may hold (the others need a code that uses them).
+ALWAYS_ALLOWED = frozenset(AXES + "fstno")
+
+
+_AXIS_SET = frozenset(AXES)
+#: G codes of a block the fast path of :meth:`Interpreter.execute` takes
+#: (G0, G1, G2, G3), as tenths
+_FAST_MOTION = {0.0: 0, 1.0: 10, 2.0: 20, 3.0: 30}
+
+
 def _pose(values: Any) -> C.Pose:
-    return tuple(float(v) for v in values)  # type: ignore[return-value]
+    return tuple(map(float, values))  # type: ignore[return-value]
 
 
 class Interpreter:
@@ -105,7 +115,7 @@ class Interpreter:
 
     def _g5x(self, index: int = 0) -> list[float]:
         base = 5201 + 20 * (index or self.coord_index)
-        return [self.params.get(base + i) for i in range(9)]
+        return self.params.numbered(base, 9)
 
     def program_position(self) -> list[float]:
         """Current position in program coordinates, machine units."""
@@ -129,13 +139,18 @@ class Interpreter:
                 if a in block.words:
                     end[i] = block.words[a] * self._k(i) + self.tlo[i]
             return end
-        prog = self.program_position()
+        # program_position() and _to_machine() with one reading of the
+        # offsets (the same arithmetic)
+        g5x, g92, tlo, pos = self._g5x(), self.g92, self.tlo, self.pos
+        prog = [pos[i] - g5x[i] - g92[i] - tlo[i] for i in range(9)]
         incremental = self.modal.distance == 910
+        words = block.words
+        k = self._k()
         for i, a in enumerate(AXES):
-            if a in block.words:
-                value = block.words[a] * self._k(i)
+            if a in words:
+                value = words[a] * (1.0 if i in ROTARY else k)
                 prog[i] = prog[i] + value if incremental else value
-        return self._to_machine(prog)
+        return [prog[i] + g5x[i] + g92[i] + tlo[i] for i in range(9)]
 
     def _emit(self, command: C.Command) -> None:
         if not self.comp.hold(command):
@@ -152,6 +167,9 @@ class Interpreter:
 
     def execute(self, block: Block) -> None:
         """Execute one block in the documented order of execution."""
+        if not block.m and len(block.g) < 2 and block.message is None \
+                and self._fast(block):
+            return
         self.line = block.line
         self.line_block = block
         gs, ms = group_codes(block)
@@ -235,6 +253,59 @@ class Interpreter:
         if 4 in ms:
             self._stop(ms[4], line)
 
+    def _fast(self, block: Block) -> bool:
+        """Execute a plain move (G0-G3 or none, axis words, F, arc words)
+        without cutter compensation: what :meth:`execute` does for it, in
+        fewer steps (most blocks of a CAM program are such moves).  False,
+        having changed nothing, for any other block."""
+        g = block.g
+        if g:
+            explicit = _FAST_MOTION.get(g[0])
+            if explicit is None:
+                return False
+            motion = explicit
+        else:
+            explicit = None
+            motion = self.modal.motion
+            if motion not in (0, 10, 20, 30):
+                return False
+        words = block.words
+        has_axes = False
+        arc_words = False
+        for letter in words:
+            if letter in _AXIS_SET:
+                has_axes = True
+            elif letter != "f":
+                if letter not in "ijkrp" or len(letter) != 1:
+                    return False
+                arc_words = True
+        if arc_words and not (motion in (20, 30)
+                              and (has_axes or explicit is not None)):
+            return False        # the general path says what is wrong
+        if self.comp.active:
+            return False
+        self.line = line = block.line
+        self.line_block = block
+        if "f" in words and self.modal.feed_mode == 940:
+            f = words["f"]
+            if f < 0:
+                raise block.error("negative feed rate", "f")
+            self.feed = self._len(f)
+            self._emit(C.SetFeedRate(self.feed, line))
+        if explicit is not None:
+            self.modal.motion = explicit
+        elif not has_axes:
+            return True
+        if motion == 10:
+            if has_axes:
+                self._straight_feed(block, self._target(block))
+        elif motion == 0:
+            if has_axes:
+                self._traverse(self._target(block), line)
+        else:
+            self._arc(block, motion)
+        return True
+
     def pos_without_tlo(self) -> list[float]:
         return [self.pos[i] - self.tlo[i] for i in range(9)]
 
@@ -272,8 +343,13 @@ class Interpreter:
         if axes and not user0 and gs.get(8) != 431 and motion == 800:
             raise block.error(
                 f"{axes[0].upper()} word with no G code to use it", axes[0])
+        users: Optional[set[str]] = None
         for letter in block.words:
-            if letter not in self._word_users(block, gs, ms, motion):
+            if letter in ALWAYS_ALLOWED:
+                continue
+            if users is None:
+                users = self._word_users(block, gs, ms, motion)
+            if letter not in users:
                 raise block.error(f"{letter.upper()} word with no G or M "
                                   "code to use it", letter)
 

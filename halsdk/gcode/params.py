@@ -127,6 +127,15 @@ class Parameters:
             return self._frames[-1].numbered.get(number, 0.0)
         return self._numbered.get(number, 0.0)
 
+    def numbered(self, first: int, count: int) -> list[float]:
+        """``#first`` .. ``#first+count-1`` (unset ones read 0), numbers
+        above the subroutine locals: what ``get`` reads for them, faster
+        (the interpreter reads offsets nine at a time)."""
+        if first <= LOCAL_NUMBERED[-1] or first + count - 1 > MAX_PARAMETER:
+            return [self.get(n) for n in range(first, first + count)]
+        get = self._numbered.get
+        return [get(n, 0.0) for n in range(first, first + count)]
+
     def set(self, key: Key, value: float) -> None:
         """Store ``value`` in parameter ``key`` (in the current scope)."""
         value = float(value)
