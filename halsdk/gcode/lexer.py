@@ -8,6 +8,7 @@ errors point at the right place.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 from typing import Optional
 
@@ -215,6 +216,45 @@ def parse_line(text: str, file: str = "<string>", lineno: int = 1) -> Line:
             seen[char] = column
         line.words.append(Word(char, _real_value(reader), column))
     return line
+
+
+#: A line the fast path reads: an optional N number, then words whose
+#: values are plain numbers (no comment, parameter, expression, o-word,
+#: block delete or '%'; spaces and tabs only between words).
+_SIMPLE = re.compile(
+    r"[ \t]*(?:[nN][ \t]*([0-9]+(?:\.[0-9]*)?)[ \t]*)?"
+    r"(?:[a-mp-zA-MP-Z][ \t]*[-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)[ \t]*)*")
+_SIMPLE_WORD = re.compile(r"([a-mp-zA-MP-Z])[ \t]*([-+]?[0-9.]+)")
+
+#: What :func:`simple_words` gives: the N number (or None) and the words
+#: as ``(letter, value, column)``, letters lower case.
+SimpleLine = tuple[Optional[float], list[tuple[str, float, int]]]
+
+
+def simple_words(text: str) -> Optional[SimpleLine]:
+    """The words of a line made of plain numbered words only (what CAM
+    programs are made of), or None when the line needs
+    :func:`parse_line`: that is the fast path of the program reader.
+
+    For a line it accepts, the words, values and columns are those
+    :func:`parse_line` reads; a line it refuses (anything else, an error
+    included) goes to :func:`parse_line`, which reads it or raises.
+    ``text`` has no line end.
+    """
+    match = _SIMPLE.fullmatch(text)
+    if match is None:
+        return None
+    number = match.group(1)
+    words: list[tuple[str, float, int]] = []
+    seen = ""
+    for word in _SIMPLE_WORD.finditer(text, match.end(1) if number else 0):
+        letter = word.group(1).lower()
+        if letter != "g" and letter != "m":
+            if letter in seen:
+                return None         # two X words: parse_line says where
+            seen += letter
+        words.append((letter, float(word.group(2)), word.start() + 1))
+    return (None if number is None else float(number)), words
 
 
 def _unsigned_number(reader: _Reader) -> float:
