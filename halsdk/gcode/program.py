@@ -10,10 +10,11 @@ from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from typing import BinaryIO, Optional, Union
 
+from ._fast import simple_block, simple_words
 from .block import Block, code_key
 from .errors import GCodeError
 from .expr import Expr, ParamRef, Where
-from .lexer import Line, OWord, parse_line, simple_words
+from .lexer import Line, OWord, parse_line
 from .params import Parameters
 
 #: Default limit of the control-flow work of one run of a program: loop
@@ -72,11 +73,13 @@ _OTHER_LINE_ENDS = (b"\x0b", b"\x0c", b"\x1c", b"\x1d", b"\x1e", b"\xc2\x85",
                     b"\xe2\x80\xa8", b"\xe2\x80\xa9")
 
 
-def _other_line_ends(chunk: bytes) -> bool:
-    """True if ``chunk`` holds a line end other than \\n and \\r\\n."""
-    if b"\r" in chunk and chunk.count(b"\r") != chunk.count(b"\r\n"):
+def _other_line_ends(chunk: bytes, end: int) -> bool:
+    """True if ``chunk[:end]`` holds a line end other than \\n and
+    \\r\\n."""
+    if chunk.find(b"\r", 0, end) >= 0 and \
+            chunk.count(b"\r", 0, end) != chunk.count(b"\r\n", 0, end):
         return True
-    return any(end in chunk for end in _OTHER_LINE_ENDS)
+    return any(chunk.find(other, 0, end) >= 0 for other in _OTHER_LINE_ENDS)
 #: Size of the pieces a program file is scanned in.
 _CHUNK = 1 << 20
 
@@ -177,34 +180,37 @@ def _read_file(path: str) -> tuple[Union[_TextLines, _FileLines],
                     if cut == 0:
                         rest = chunk
                         continue
-                    chunk, rest = chunk[:cut], chunk[cut:]
+                    rest = chunk[cut:]
                 elif not chunk:
                     break
                 else:
+                    cut = len(chunk)
                     rest = b""
-                if _other_line_ends(chunk):
+                # the lines of chunk[:cut], without copying them
+                if _other_line_ends(chunk, cut):
                     return _read_text(path)
-                chunk.decode("utf-8")     # the error a text read gives
+                if not chunk.isascii():
+                    chunk[:cut].decode("utf-8")  # the error a text read gives
                 counted = 0     # newlines before here are in ``index``
                 skip = 0        # the end of the last candidate line
-                for match in _CANDIDATE_BYTES.finditer(chunk):
+                for match in _CANDIDATE_BYTES.finditer(chunk, 0, cut):
                     at = match.start()
                     if at < skip:
                         continue        # a second one on the same line
                     start = chunk.rfind(b"\n", 0, at) + 1
-                    stop = chunk.find(b"\n", at)
-                    stop = len(chunk) if stop < 0 else stop
+                    stop = chunk.find(b"\n", at, cut)
+                    stop = cut if stop < 0 else stop
                     index += chunk.count(b"\n", counted, start)
-                    counted = skip = start
+                    counted = start
                     offsets[index] = base + start
                     candidates.append(
                         (index, chunk[start:stop].decode("utf-8")
                          .rstrip("\r\n")))
                     skip = stop + 1
-                index += chunk.count(b"\n", counted)
-                if not chunk.endswith(b"\n"):
+                index += chunk.count(b"\n", counted, cut)
+                if chunk[cut - 1] != 10:
                     index += 1          # a last line without its line end
-                base += len(chunk)
+                base += cut
                 if not piece:
                     break
     except OSError as exc:
@@ -431,29 +437,6 @@ def _scan(unit: _Unit) -> _Structure:
     return result
 
 
-def _simple_block(file: str, number: int, text: str,
-                  line_number: Optional[float],
-                  words: list[tuple[str, float, int]]) -> Block:
-    """The block of a fast-path line: what :meth:`Program._block` makes
-    of the same words."""
-    g: list[float] = []
-    m: list[float] = []
-    values: dict[str, float] = {}
-    columns: dict[str, int] = {}
-    for letter, value, column in words:
-        if letter == "g" or letter == "m":
-            value = round(value, 4)
-            key = code_key(letter, value)
-            (g if letter == "g" else m).append(value)
-            columns.setdefault(key, column)
-            columns.setdefault(letter, column)
-        else:
-            values[letter] = value
-            columns[letter] = column
-    return Block(file, number, text, g, m, values, columns, [], None, False,
-                 line_number)
-
-
 @dataclass
 class _Frame:
     """A subroutine call in progress."""
@@ -582,8 +565,10 @@ class Program:
         block = Block(line.file, line.number, line.text,
                       block_delete=line.block_delete,
                       line_number=line.line_number)
+        params = self.params
+        where = Where(line.file, line.number)
         for word in line.words:
-            value = self._value(word.value, line)
+            value = word.value.evaluate(params, where)
             if word.letter in "gm":
                 value = round(value, 4)
                 key = code_key(word.letter, value)
@@ -594,7 +579,7 @@ class Program:
                 block.words[word.letter] = value
                 block.columns[word.letter] = word.column
         values = [(self._parameter_key(a.target, line),
-                   self._value(a.value, line), a.column)
+                   a.value.evaluate(params, where), a.column)
                   for a in line.assignments]
         for param, value, column in values:
             self._set(param, value, line, column)
@@ -663,7 +648,7 @@ class Program:
                 if not words:
                     continue
                 seen_code = True
-                block = _simple_block(unit.file, index, text, number, words)
+                block = simple_block(unit.file, index, text, number, words)
                 clock()
                 yield block
                 self._idle_since = clock()
