@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
-from typing import Any, Optional
+from typing import Any, Callable, Optional
 
 from . import canon as C
 from .block import Block, code_key
@@ -995,30 +995,34 @@ class Interpreter:
         if len(name) == 2 and name[1] in AXES:
             i = AXES.index(name[1])
             return self.program_position()[i] / self._k(i)
-        m = self.modal
-        table: dict[str, float] = {
-            "_feed": self.feed / self._k(),
-            "_rpm": self.speed,
-            "_metric": float(self.program_metric),
-            "_imperial": float(not self.program_metric),
-            "_absolute": float(m.distance == 900),
-            "_incremental": float(m.distance == 910),
-            "_inverse_time": float(m.feed_mode == 930),
-            "_units_per_minute": float(m.feed_mode == 940),
-            "_coord_system": float(m.coord_system),
-            "_motion_mode": float(m.motion),
-            "_plane": float(m.plane),
-            "_ccomp": float(m.cutter_comp),
-            "_tool_offset": float(m.tool_length != 490),
-            "_retract_r_plane": float(m.retract == 990),
-            "_retract_old_z": float(m.retract == 980),
-            "_spindle_on": float(m.spindle != 50),
-            "_spindle_cw": float(m.spindle == 30),
-            "_mist": float(m.mist),
-            "_flood": float(m.flood),
-            "_current_tool": float(self.current_tool),
-            "_selected_tool": float(self.selected_tool),
-            "_selected_pocket": float(self.selected_pocket),
-            "_line": float(self.line),
-        }
-        return table.get(name)
+        value = _PREDEFINED.get(name)
+        return None if value is None else value(self, self.modal)
+
+
+#: The read-only predefined named parameters: name -> its value, from the
+#: interpreter and its modal state (computed when the name is read).
+_PREDEFINED: dict[str, Callable[[Interpreter, ModalState], float]] = {
+    "_feed": lambda i, m: i.feed / i._k(),
+    "_rpm": lambda i, m: i.speed,
+    "_metric": lambda i, m: float(i.program_metric),
+    "_imperial": lambda i, m: float(not i.program_metric),
+    "_absolute": lambda i, m: float(m.distance == 900),
+    "_incremental": lambda i, m: float(m.distance == 910),
+    "_inverse_time": lambda i, m: float(m.feed_mode == 930),
+    "_units_per_minute": lambda i, m: float(m.feed_mode == 940),
+    "_coord_system": lambda i, m: float(m.coord_system),
+    "_motion_mode": lambda i, m: float(m.motion),
+    "_plane": lambda i, m: float(m.plane),
+    "_ccomp": lambda i, m: float(m.cutter_comp),
+    "_tool_offset": lambda i, m: float(m.tool_length != 490),
+    "_retract_r_plane": lambda i, m: float(m.retract == 990),
+    "_retract_old_z": lambda i, m: float(m.retract == 980),
+    "_spindle_on": lambda i, m: float(m.spindle != 50),
+    "_spindle_cw": lambda i, m: float(m.spindle == 30),
+    "_mist": lambda i, m: float(m.mist),
+    "_flood": lambda i, m: float(m.flood),
+    "_current_tool": lambda i, m: float(i.current_tool),
+    "_selected_tool": lambda i, m: float(i.selected_tool),
+    "_selected_pocket": lambda i, m: float(i.selected_pocket),
+    "_line": lambda i, m: float(i.line),
+}

@@ -23,9 +23,17 @@ LOCAL_NUMBERED = range(1, 31)
 Key = Union[int, str]
 
 
+_NORMALIZED: dict[str, str] = {}
+
+
 def normalize_name(name: str) -> str:
     """Lower-case a parameter name and drop its spaces and tabs."""
-    return "".join(name.split()).lower()
+    normal = _NORMALIZED.get(name)
+    if normal is None:
+        normal = "".join(name.split()).lower()
+        if len(_NORMALIZED) < 4096:     # the names of a few programs
+            _NORMALIZED[name] = normal
+    return normal
 
 
 class _Frame:
