@@ -13,9 +13,12 @@ comment, a parameter, an expression, an o-word, an error ...) is refused
 from cpython.unicode cimport PyUnicode_AsUTF8AndSize
 from libc.string cimport memcpy
 
+import bisect
 import builtins
 
 from .block import Block, code_key
+from .errors import GCodeError
+from .lexer import parse_line
 
 cdef extern from "Python.h":
     double PyOS_string_to_double(const char *s, char **endptr,
@@ -67,6 +70,10 @@ def simple_words(str text):
     """``(N number or None, [(letter, value, column), ...])`` of a line of
     plain numbered words (letters lower case, columns 1-based), or None
     when the line needs the full lexer.  ``text`` has no line end."""
+    return _simple_words(text)
+
+
+cdef object _simple_words(str text):
     cdef Py_ssize_t n
     cdef const char *s
     cdef Py_ssize_t pos = 0, end, column
@@ -123,6 +130,11 @@ def simple_block(str file, int number, str text, object line_number,
                  list words):
     """The :class:`Block` of the words :func:`simple_words` read: what
     ``Program`` makes of the same words through the full lexer."""
+    return _simple_block(file, number, text, line_number, words)
+
+
+cdef object _simple_block(str file, int number, str text,
+                          object line_number, list words):
     cdef list g = []
     cdef list m = []
     cdef dict values = {}
@@ -155,3 +167,181 @@ def simple_block(str file, int number, str text, object line_number,
     block.block_delete = False
     block.line_number = line_number
     return block
+
+
+#: what :func:`read_line` gives for a plain line without words
+EMPTY = ("empty line",)
+
+
+def read_line(object unit, Py_ssize_t index):
+    """Line ``index`` of a program's ``_Unit``, ready to run: a new
+    :class:`Block` for a plain line (:data:`EMPTY` when it has no words),
+    the ``Line`` of another line, the ``GCodeError`` of a line that
+    cannot be read, None past the end.
+
+    The lines of loops and subroutine definitions (the unit's keep
+    ranges) are kept once read, as they run again.
+    """
+    cdef dict kept = unit._kept
+    cdef object entry = kept.get(index) if kept else None
+    cdef object text, simple
+    cdef list starts
+    cdef Py_ssize_t at
+    if entry is None:
+        entry = unit.owords.get(index)
+        if entry is not None:
+            return entry
+        text = unit.source.line(index)
+        if text is None:
+            return None
+        simple = _simple_words(text)
+        if simple is not None:
+            entry = (text, simple[0], simple[1])
+        else:
+            try:
+                entry = parse_line(text, unit.file, index + 1)
+            except GCodeError as exc:
+                entry = exc
+        starts = unit._keep_starts
+        if starts:
+            at = bisect.bisect_right(starts, index) - 1
+            if at >= 0 and index <= unit._keep_ends[at]:
+                kept[index] = entry
+    if type(entry) is tuple:
+        if not entry[2]:
+            return EMPTY
+        return _simple_block(unit.file, index + 1, entry[0], entry[1],
+                             entry[2])
+    return entry
+
+
+# -- the interpreter's plain moves ------------------------------------------
+
+import math
+
+from . import canon as C
+
+cdef object _dist = math.dist
+cdef tuple _AXES = ("x", "y", "z", "a", "b", "c", "u", "v", "w")
+cdef dict _FAST_MOTION = {0.0: 0, 1.0: 10, 2.0: 20, 3.0: 30}
+#: interp.COORD_CODES (G54 .. G59.3 in tenths)
+COORD_CODES = (540, 550, 560, 570, 580, 590, 591, 592, 593)
+cdef tuple _COORD_CODES = COORD_CODES
+cdef object _SetFeedRate = C.SetFeedRate
+cdef object _StraightFeed = C.StraightFeed
+cdef object _StraightTraverse = C.StraightTraverse
+
+
+cdef list _target(object interp, dict words, object modal):
+    """``Interpreter._target(block)`` (not G53): the machine end point
+    from the axis words, the same arithmetic in the same order."""
+    cdef list g92 = interp.g92
+    cdef list tlo = interp.tlo
+    cdef list pos = interp.pos
+    cdef double prog[9]
+    cdef double g5x[9]
+    cdef double k
+    cdef double value
+    cdef bint incremental = modal.distance == 910
+    cdef int i, base
+    cdef object word
+    cdef dict numbered = interp.params._numbered
+    # Interpreter._g5x(): the offsets of the active coordinate system
+    # (numbers above the subroutine locals: read as Parameters.numbered)
+    base = 5201 + 20 * (_COORD_CODES.index(modal.coord_system) + 1)
+    for i in range(9):
+        g5x[i] = numbered.get(base + i, 0.0)
+    # Interpreter._k(): program units to machine units
+    if (modal.units == 210) == interp.machine_metric:
+        k = 1.0
+    else:
+        k = 25.4 if interp.machine_metric else 1 / 25.4
+    for i in range(9):
+        prog[i] = <double>pos[i] - g5x[i] - <double>g92[i] - <double>tlo[i]
+    for i in range(9):
+        word = words.get(_AXES[i])
+        if word is not None:
+            value = <double>word * (1.0 if 3 <= i <= 5 else k)
+            prog[i] = prog[i] + value if incremental else value
+    return [prog[i] + g5x[i] + <double>g92[i] + <double>tlo[i]
+            for i in range(9)]
+
+
+cdef inline _emit(object interp, object command):
+    """Interpreter._emit"""
+    if not interp.comp.hold(command):
+        interp.canon.emit(command)
+
+
+def fast_move(object interp, object block):
+    """``Interpreter._fast``: execute a plain move (G0-G3 or the modal
+    motion; axis words, F and arc words only; no cutter compensation)
+    as ``Interpreter.execute`` does, in fewer steps; False, having
+    changed nothing, for any other block.
+
+    It does what ``execute``, ``_target``, ``_straight_feed`` and
+    ``_traverse`` do for such a block: a change to what a plain move
+    does belongs in both places (arcs go to ``Interpreter._arc``).
+    """
+    cdef list g = block.g
+    cdef dict words = block.words
+    cdef object explicit, modal, f, end, line, feed
+    cdef int motion
+    cdef bint has_axes = False, arc_words = False
+    cdef str letter
+    modal = interp.modal
+    if g:
+        explicit = _FAST_MOTION.get(g[0])
+        if explicit is None:
+            return False
+        motion = explicit
+    else:
+        explicit = None
+        motion = modal.motion
+        if motion != 0 and motion != 10 and motion != 20 and motion != 30:
+            return False
+    for letter in words:
+        if len(letter) == 1 and letter in "xyzabcuvw":
+            has_axes = True
+        elif letter != "f":
+            if len(letter) != 1 or letter not in "ijkrp":
+                return False
+            arc_words = True
+    if arc_words and not ((motion == 20 or motion == 30)
+                          and (has_axes or explicit is not None)):
+        return False
+    if interp.comp.active:
+        return False
+    line = block.line
+    interp.line = line
+    interp.line_block = block
+    if modal.feed_mode == 940:
+        f = words.get("f")
+        if f is not None:
+            if f < 0:
+                raise block.error("negative feed rate", "f")
+            interp.feed = interp._len(f)
+            interp._emit(_SetFeedRate(interp.feed, line))
+    if explicit is not None:
+        modal.motion = explicit
+    elif not has_axes:
+        return True
+    if motion == 10:
+        if has_axes:
+            end = _target(interp, words, modal)
+            if modal.feed_mode == 930:
+                feed = interp._feed_for(block, _dist(interp.pos, end))
+            else:
+                feed = interp.feed
+                if feed <= 0:
+                    raise block.error("feed move with zero feed rate", "")
+            _emit(interp, _StraightFeed(tuple(end), feed, line))
+            interp.pos = end
+    elif motion == 0:
+        if has_axes:
+            end = _target(interp, words, modal)
+            _emit(interp, _StraightTraverse(tuple(end), line))
+            interp.pos = end
+    else:
+        interp._arc(block, motion)
+    return True

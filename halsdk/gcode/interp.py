@@ -31,6 +31,7 @@ from dataclasses import replace
 from typing import Any, Callable, Optional
 
 from . import canon as C
+from ._fast import fast_move
 from .block import Block, code_key
 from .cutter_radius import CutterComp, CutterRadiusError
 from .modal import AXIS_USERS_GROUP0, ModalState, group_codes
@@ -47,12 +48,6 @@ UNSUPPORTED_MOTION = {760: "G76", 870: "G87"}
 
 #: Letters every block may hold (the others need a code that uses them).
 ALWAYS_ALLOWED = frozenset(AXES + "fstno")
-
-
-_AXIS_SET = frozenset(AXES)
-#: G codes of a block the fast path of :meth:`Interpreter.execute` takes
-#: (G0, G1, G2, G3), as tenths
-_FAST_MOTION = {0.0: 0, 1.0: 10, 2.0: 20, 3.0: 30}
 
 
 def _pose(values: Any) -> C.Pose:
@@ -167,9 +162,16 @@ class Interpreter:
 
     def execute(self, block: Block) -> None:
         """Execute one block in the documented order of execution."""
+        # plain moves (most blocks of a CAM program) take a short path,
+        # compiled: it does what this method, _target, _straight_feed and
+        # _traverse do for them, so a change to those belongs there too
         if not block.m and len(block.g) < 2 and block.message is None \
-                and self._fast(block):
+                and fast_move(self, block):
             return
+        self._execute(block)
+
+    def _execute(self, block: Block) -> None:
+        """:meth:`execute` without the short path of plain moves."""
         self.line = block.line
         self.line_block = block
         gs, ms = group_codes(block)
@@ -252,59 +254,6 @@ class Interpreter:
         self._motion(block, gs)
         if 4 in ms:
             self._stop(ms[4], line)
-
-    def _fast(self, block: Block) -> bool:
-        """Execute a plain move (G0-G3 or none, axis words, F, arc words)
-        without cutter compensation: what :meth:`execute` does for it, in
-        fewer steps (most blocks of a CAM program are such moves).  False,
-        having changed nothing, for any other block."""
-        g = block.g
-        if g:
-            explicit = _FAST_MOTION.get(g[0])
-            if explicit is None:
-                return False
-            motion = explicit
-        else:
-            explicit = None
-            motion = self.modal.motion
-            if motion not in (0, 10, 20, 30):
-                return False
-        words = block.words
-        has_axes = False
-        arc_words = False
-        for letter in words:
-            if letter in _AXIS_SET:
-                has_axes = True
-            elif letter != "f":
-                if letter not in "ijkrp" or len(letter) != 1:
-                    return False
-                arc_words = True
-        if arc_words and not (motion in (20, 30)
-                              and (has_axes or explicit is not None)):
-            return False        # the general path says what is wrong
-        if self.comp.active:
-            return False
-        self.line = line = block.line
-        self.line_block = block
-        if "f" in words and self.modal.feed_mode == 940:
-            f = words["f"]
-            if f < 0:
-                raise block.error("negative feed rate", "f")
-            self.feed = self._len(f)
-            self._emit(C.SetFeedRate(self.feed, line))
-        if explicit is not None:
-            self.modal.motion = explicit
-        elif not has_axes:
-            return True
-        if motion == 10:
-            if has_axes:
-                self._straight_feed(block, self._target(block))
-        elif motion == 0:
-            if has_axes:
-                self._traverse(self._target(block), line)
-        else:
-            self._arc(block, motion)
-        return True
 
     def pos_without_tlo(self) -> list[float]:
         return [self.pos[i] - self.tlo[i] for i in range(9)]

@@ -10,7 +10,7 @@ from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from typing import BinaryIO, Optional, Union
 
-from ._fast import simple_block, simple_words
+from ._fast import EMPTY, read_line
 from .block import Block, code_key
 from .errors import GCodeError
 from .expr import Expr, ParamRef, Where
@@ -236,17 +236,6 @@ def _text_lines(text: str) -> tuple[_TextLines, list[tuple[int, str]]]:
                                if search(t)]
 
 
-def _parse(text: str, file: str, number: int) -> _Entry:
-    """Read one line: the fast path when it can, else the lexer."""
-    simple = simple_words(text)
-    if simple is not None:
-        return (text, simple[0], simple[1])
-    try:
-        return parse_line(text, file, number)
-    except GCodeError as exc:
-        return exc
-
-
 class _Unit:
     """One source file (or string): its o-word lines, their structure,
     and the other lines read as the run reaches them.
@@ -300,24 +289,6 @@ class _Unit:
     def count(self) -> int:
         """The number of lines."""
         return self.source.count
-
-    def entry(self, index: int) -> Optional[_Entry]:
-        """Line ``index`` read, or None past the end."""
-        kept = self._kept.get(index)
-        if kept is not None:
-            return kept
-        oword = self.owords.get(index)
-        if oword is not None:
-            return oword
-        text = self.source.line(index)
-        if text is None:
-            return None
-        entry = _parse(text, self.file, index + 1)
-        if self._keep_starts:
-            at = bisect.bisect_right(self._keep_starts, index) - 1
-            if at >= 0 and index <= self._keep_ends[at]:
-                self._kept[index] = entry
-        return entry
 
     def oword(self, index: int) -> Optional[OWord]:
         line = self.owords.get(index)
@@ -626,9 +597,8 @@ class Program:
         seen_code = False
         clock = self.clock
         structure = unit.structure
-        entry_of = unit.entry
         while True:
-            entry = entry_of(index)
+            entry = read_line(unit, index)
             if entry is None:
                 if frames:  # pragma: no cover - the scan rules it out
                     raise GCodeError(
@@ -641,20 +611,19 @@ class Program:
                     # a subroutine definition met in the main flow: skip it
                     index = end + 1
                     continue
-            if entry.__class__ is tuple:
-                # the fast path: plain numbered words only
+            if entry.__class__ is Block:
+                # the fast path: a line of plain numbered words
                 index += 1
-                text, number, words = entry
-                if not words:
-                    continue
                 seen_code = True
-                block = simple_block(unit.file, index, text, number, words)
                 clock()
-                yield block
+                yield entry
                 self._idle_since = clock()
-                if block.m and any(abs(m - 2) < 1e-6 or abs(m - 30) < 1e-6
-                                   for m in block.m):
+                if entry.m and any(abs(m - 2) < 1e-6 or abs(m - 30) < 1e-6
+                                   for m in entry.m):
                     return
+                continue
+            if entry is EMPTY:
+                index += 1
                 continue
             if isinstance(entry, GCodeError):
                 raise entry
@@ -713,7 +682,7 @@ class Program:
                 self.params.push_scope(args)
                 frames.append(_Frame(unit, index + 1, name))
                 unit = target
-                structure, entry_of = unit.structure, unit.entry
+                structure = unit.structure
                 index = target.structure.subs[name][0] + 1
             elif keyword in ("return", "endsub"):
                 if keyword == "endsub" and not frames:
@@ -731,7 +700,7 @@ class Program:
                 else:
                     self.params.set("_value_returned", 0.0)
                 unit, index = frame.return_unit, frame.return_index
-                structure, entry_of = unit.structure, unit.entry
+                structure = unit.structure
             elif keyword == "sub":
                 index = structure.subs[_name_text(oword)][1] + 1
             elif keyword == "if":
