@@ -289,6 +289,8 @@ def fast_move(object interp, object block):
     cdef int motion
     cdef bint has_axes = False, arc_words = False
     cdef str letter
+    if block.m or len(g) > 1 or block.message is not None:
+        return False
     modal = interp.modal
     if g:
         explicit = _FAST_MOTION.get(g[0])

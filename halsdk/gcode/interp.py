@@ -165,8 +165,7 @@ class Interpreter:
         # plain moves (most blocks of a CAM program) take a short path,
         # compiled: it does what this method, _target, _straight_feed and
         # _traverse do for them, so a change to those belongs there too
-        if not block.m and len(block.g) < 2 and block.message is None \
-                and fast_move(self, block):
+        if fast_move(self, block):
             return
         self._execute(block)
 
