@@ -6,6 +6,7 @@ from .block import Block
 
 EMPTY: tuple[str]
 COORD_CODES: tuple[int, ...]
+PLANES: dict[int, tuple[int, int, int, str]]
 
 def simple_words(text: str) -> Optional[
         tuple[Optional[float], list[tuple[str, float, int]]]]: ...

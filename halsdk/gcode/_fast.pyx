@@ -230,6 +230,21 @@ cdef tuple _COORD_CODES = COORD_CODES
 cdef object _SetFeedRate = C.SetFeedRate
 cdef object _StraightFeed = C.StraightFeed
 cdef object _StraightTraverse = C.StraightTraverse
+cdef object _ArcFeed = C.ArcFeed
+cdef object _hypot = math.hypot
+cdef object _atan2 = math.atan2
+cdef double _PI = math.pi
+#: interp.PLANES: plane -> (first axis, second axis, normal axis, centre
+#: words)
+PLANES = {170: (0, 1, 2, "ij"), 180: (2, 0, 1, "ki"), 190: (1, 2, 0, "jk")}
+cdef dict _PLANES = PLANES
+
+
+cdef double _factor(object interp, object modal):
+    """Interpreter._k(): program units to machine units (linear axes)."""
+    if (modal.units == 210) == interp.machine_metric:
+        return 1.0
+    return 25.4 if interp.machine_metric else 1 / 25.4
 
 
 cdef list _target(object interp, dict words, object modal):
@@ -251,11 +266,7 @@ cdef list _target(object interp, dict words, object modal):
     base = 5201 + 20 * (_COORD_CODES.index(modal.coord_system) + 1)
     for i in range(9):
         g5x[i] = numbered.get(base + i, 0.0)
-    # Interpreter._k(): program units to machine units
-    if (modal.units == 210) == interp.machine_metric:
-        k = 1.0
-    else:
-        k = 25.4 if interp.machine_metric else 1 / 25.4
+    k = _factor(interp, modal)
     for i in range(9):
         prog[i] = <double>pos[i] - g5x[i] - <double>g92[i] - <double>tlo[i]
     for i in range(9):
@@ -344,6 +355,79 @@ def fast_move(object interp, object block):
             end = _target(interp, words, modal)
             _emit(interp, _StraightTraverse(tuple(end), line))
             interp.pos = end
-    else:
+    elif not _arc(interp, block, words, modal, motion, line):
         interp._arc(block, motion)
+    return True
+
+
+cdef bint _arc(object interp, object block, dict words, object modal,
+               int motion, object line) except -1:
+    """Interpreter._arc for a centre-format arc with relative centres
+    (G91.1), the same checks and arithmetic in the same order; False,
+    having done nothing, for the other arcs."""
+    cdef int a1, a2, i, turns, turn
+    cdef double s1, s2, e1, e2, k, tol, o1, o2, c1, c2, r1, r2
+    cdef double r, t0, t1, sweep, planar
+    cdef str w1, w2
+    cdef list start, end
+    cdef object key, feed, p
+    if modal.arc_distance == 901 or "r" in words:
+        return False
+    a1, a2, _, centre = _PLANES[modal.plane]
+    w1, w2 = centre[0], centre[1]
+    key = code_key("g", motion / 10)
+    start = interp.pos
+    end = _target(interp, words, modal)
+    s1, s2, e1, e2 = start[a1], start[a2], end[a1], end[a2]
+    k = _factor(interp, modal)
+    tol = 0.005 if interp.machine_metric else 0.0005
+    if w1 not in words and w2 not in words:
+        raise block.error(f"{w1.upper()} and {w2.upper()} words both "
+                          "missing for a centre-format arc", key)
+    o1 = <double>words.get(w1, 0.0) * k
+    o2 = <double>words.get(w2, 0.0) * k
+    c1 = s1 + o1
+    c2 = s2 + o2
+    r1 = _hypot(s1 - c1, s2 - c2)
+    r2 = _hypot(e1 - c1, e2 - c2)
+    if r1 < 1e-9:
+        raise block.error("zero radius arc", key)
+    if abs(r1 - r2) > tol and abs(r1 - r2) > 0.001 * r1:
+        raise block.error(
+            f"radius to end of arc differs from radius to start "
+            f"by {abs(r1 - r2) / k:.4g}", key)
+    turns = 1
+    if "p" in words:
+        p = words["p"]
+        if p < 1 or abs(p - _round(p)) > 1e-6:
+            raise block.error("arc P (turns) must be a positive integer",
+                              "p")
+        turns = int(_round(p))
+    turn = turns if motion == 30 else -turns
+    # Interpreter._arc_length
+    r = _hypot(s1 - c1, s2 - c2)
+    t0 = _atan2(s2 - c2, s1 - c1)
+    t1 = _atan2(e2 - c2, e1 - c1)
+    sweep = t1 - t0
+    if turn > 0:
+        while sweep <= 1e-12:
+            sweep += 2 * _PI
+    else:
+        while sweep >= -1e-12:
+            sweep -= 2 * _PI
+    sweep = abs(sweep) + 2 * _PI * (abs(turn) - 1)
+    planar = r * sweep
+    length = _hypot(planar, _hypot(*[
+        <double>end[i] - <double>start[i] for i in range(9)
+        if i != a1 and i != a2]))
+    # Interpreter._feed_for
+    if modal.feed_mode == 930:
+        feed = interp._feed_for(block, length)
+    else:
+        feed = interp.feed
+        if feed <= 0:
+            raise block.error("feed move with zero feed rate", "")
+    _emit(interp, _ArcFeed(tuple(end), (c1, c2), modal.plane // 10, turn,
+                           feed, line))
+    interp.pos = end
     return True

@@ -14,8 +14,8 @@ import copy
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from halsdk.gcode import GCodeError, Parameters, Program
-from halsdk.gcode import _fast, interp as interp_module
+from halsdk.gcode import GCodeError, Parameters, Program, _fast
+from halsdk.gcode import interp as interp_module
 from halsdk.gcode.canon import RecordingCanon
 from halsdk.gcode.interp import Interpreter
 
@@ -46,7 +46,7 @@ def outcome(fn, block) -> object:
     return None
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=600, deadline=None)
 @given(SETUP, MOVE)
 def test_plain_moves_take_the_general_path_s_way(setup: list[str],
                                                  move: tuple) -> None:
@@ -83,3 +83,39 @@ def test_fast_path_takes_plain_moves() -> None:
 
 def test_fast_path_constants_are_the_interpreter_s() -> None:
     assert _fast.COORD_CODES == interp_module.COORD_CODES
+
+
+small = st.sampled_from(["0", "1", "-2.5", "0.1234", "3", "-0.75"])
+
+
+@settings(max_examples=300, deadline=None)
+@given(SETUP, st.sampled_from(["G2", "G3", ""]), small, small,
+       st.sampled_from(["", " Z1", " Z-0.5 A3"]),
+       st.sampled_from(["", " P2", " P1", " P0.5", " F120"]),
+       st.sampled_from(["G17", "G18", "G19"]))
+def test_arcs_take_the_general_path_s_way(setup: list[str], code: str,
+                                          i: str, j: str, helix: str,
+                                          extra: str, plane: str) -> None:
+    # incremental: the end is twice the centre offset, a half circle
+    setup = setup + [f"{plane} G91 G91.1 F100"]
+    first, second, w1, w2 = {"G17": ("X", "Y", "I", "J"),
+                             "G18": ("Z", "X", "K", "I"),
+                             "G19": ("Y", "Z", "J", "K")}[plane]
+    if first in helix or second in helix:
+        helix = ""
+    move = (f"{code} {first}{2 * float(i)} {second}{2 * float(j)} "
+            f"{w1}{i} {w2}{j}{helix}{extra}")
+    params = Parameters()
+    fast = Interpreter(params, None, RecordingCanon())
+    try:
+        fast.run(Program("\n".join(setup) + "\n", "s.ngc", params))
+    except GCodeError:
+        return
+    general = copy.deepcopy(fast)
+    block = next(Program(move + "\n", "m.ngc", Parameters()).blocks())
+    assert outcome(fast.execute, block) == outcome(general._execute, block)
+    assert state(fast, fast.canon) == state(general, general.canon)
+
+
+def test_fast_path_planes_are_the_interpreter_s() -> None:
+    assert _fast.PLANES == interp_module.PLANES
