@@ -15,6 +15,7 @@ from libc.string cimport memcpy
 
 import bisect
 import builtins
+import dataclasses
 
 from .block import Block, code_key
 from .errors import GCodeError
@@ -25,8 +26,20 @@ cdef extern from "Python.h":
                                  object overflow_exception) except? -1.0
 
 cdef object _round = builtins.round
+#: code_key of G and M numbers, by number (0 is not kept: -0.0 == 0.0)
+cdef dict _G_KEYS = {}
+cdef dict _M_KEYS = {}
+#: round(number, 4) of G and M numbers (0 is not kept: -0.0 == 0.0)
+cdef dict _ROUNDED = {}
 cdef tuple _LETTERS = tuple(chr(c) for c in range(ord("a"), ord("z") + 1))
 cdef object _new_block = Block.__new__
+#: Block is a dataclass of these fields that its __init__ only stores
+cdef bint _DIRECT_BLOCK = (
+    tuple(f.name for f in dataclasses.fields(Block)) == (
+        "file", "line", "text", "g", "m", "words", "columns", "comments",
+        "message", "block_delete", "line_number")
+    and not hasattr(Block, "__post_init__")
+    and "__slots__" not in Block.__dict__)
 
 
 cdef inline bint _space(char c) noexcept nogil:
@@ -140,11 +153,23 @@ cdef object _simple_block(str file, int number, str text,
     cdef dict values = {}
     cdef dict columns = {}
     cdef str letter
-    cdef object value, column, key
+    cdef object value, column, key, rounded
+    cdef dict keys
     for letter, value, column in words:
         if letter == "g" or letter == "m":
-            value = _round(value, 4)
-            key = code_key(letter, value)
+            # round(value, 4), slow (it converts to decimal), kept
+            rounded = _ROUNDED.get(value)
+            if rounded is None:
+                rounded = _round(value, 4)
+                if value and len(_ROUNDED) < 1024:
+                    _ROUNDED[value] = rounded
+            value = rounded
+            keys = _G_KEYS if letter == "g" else _M_KEYS
+            key = keys.get(value)
+            if key is None:
+                key = code_key(letter, value)
+                if value and len(keys) < 1024:
+                    keys[value] = key
             if letter == "g":
                 g.append(value)
             else:
@@ -154,23 +179,28 @@ cdef object _simple_block(str file, int number, str text,
         else:
             values[letter] = value
             columns[letter] = column
+    if not _DIRECT_BLOCK:
+        return Block(file, number, text, g, m, values, columns, [], None,
+                     False, line_number)
+    # what Block(...) stores, without running its __init__
     block = _new_block(Block)
-    block.file = file
-    block.line = number
-    block.text = text
-    block.g = g
-    block.m = m
-    block.words = values
-    block.columns = columns
-    block.comments = []
-    block.message = None
-    block.block_delete = False
-    block.line_number = line_number
+    block.__dict__ = {"file": file, "line": number, "text": text, "g": g,
+                      "m": m, "words": values, "columns": columns,
+                      "comments": [], "message": None,
+                      "block_delete": False, "line_number": line_number}
     return block
 
 
 #: what :func:`read_line` gives for a plain line without words
 EMPTY = ("empty line",)
+#: the class of streamed program files (program._FileLines, set by it)
+cdef object _FileLines = None
+
+
+def set_file_lines(cls):
+    """Tell :func:`read_line` the class of streamed files."""
+    global _FileLines
+    _FileLines = cls
 
 
 def read_line(object unit, Py_ssize_t index):
@@ -184,16 +214,24 @@ def read_line(object unit, Py_ssize_t index):
     """
     cdef dict kept = unit._kept
     cdef object entry = kept.get(index) if kept else None
-    cdef object text, simple
+    cdef object text, simple, source, raw
     cdef list starts
     cdef Py_ssize_t at
     if entry is None:
         entry = unit.owords.get(index)
         if entry is not None:
             return entry
-        text = unit.source.line(index)
-        if text is None:
-            return None
+        source = unit.source
+        if source.__class__ is _FileLines and source._file is not None \
+                and index == source._next and index < source.count:
+            # _FileLines.line, sequential
+            raw = source._file.readline()
+            source._next = index + 1
+            text = raw.decode("utf-8").rstrip("\r\n")
+        else:
+            text = source.line(index)
+            if text is None:
+                return None
         simple = _simple_words(text)
         if simple is not None:
             entry = (text, simple[0], simple[1])
@@ -231,6 +269,49 @@ cdef object _SetFeedRate = C.SetFeedRate
 cdef object _StraightFeed = C.StraightFeed
 cdef object _StraightTraverse = C.StraightTraverse
 cdef object _ArcFeed = C.ArcFeed
+
+
+cdef bint _plain(object cls, tuple names):
+    """True if ``cls`` is a dataclass of just the fields ``names`` that
+    its __init__ only stores (no __post_init__, no slots): then an
+    instance can be made by filling its __dict__, which is what a frozen
+    dataclass's __init__ does, in a third of the time."""
+    return (tuple(f.name for f in dataclasses.fields(cls)) == names
+            and not hasattr(cls, "__post_init__")
+            and "__slots__" not in cls.__dict__)
+
+
+cdef bint _DIRECT_FEED = _plain(_StraightFeed, ("end", "feed", "line"))
+cdef bint _DIRECT_TRAVERSE = _plain(_StraightTraverse, ("end", "line"))
+cdef bint _DIRECT_ARC = _plain(
+    _ArcFeed, ("end", "center", "plane", "turn", "feed", "line"))
+cdef object _new = object.__new__
+
+
+cdef object _straight_feed(tuple end, object feed, object line):
+    if not _DIRECT_FEED:
+        return _StraightFeed(end, feed, line)
+    command = _new(_StraightFeed)
+    command.__dict__.update(end=end, feed=feed, line=line)
+    return command
+
+
+cdef object _straight_traverse(tuple end, object line):
+    if not _DIRECT_TRAVERSE:
+        return _StraightTraverse(end, line)
+    command = _new(_StraightTraverse)
+    command.__dict__.update(end=end, line=line)
+    return command
+
+
+cdef object _arc_feed(tuple end, tuple center, object plane, object turn,
+                      object feed, object line):
+    if not _DIRECT_ARC:
+        return _ArcFeed(end, center, plane, turn, feed, line)
+    command = _new(_ArcFeed)
+    command.__dict__.update(end=end, center=center, plane=plane, turn=turn,
+                            feed=feed, line=line)
+    return command
 cdef object _hypot = math.hypot
 cdef object _atan2 = math.atan2
 cdef double _PI = math.pi
@@ -348,12 +429,12 @@ def fast_move(object interp, object block):
                 feed = interp.feed
                 if feed <= 0:
                     raise block.error("feed move with zero feed rate", "")
-            _emit(interp, _StraightFeed(tuple(end), feed, line))
+            _emit(interp, _straight_feed(tuple(end), feed, line))
             interp.pos = end
     elif motion == 0:
         if has_axes:
             end = _target(interp, words, modal)
-            _emit(interp, _StraightTraverse(tuple(end), line))
+            _emit(interp, _straight_traverse(tuple(end), line))
             interp.pos = end
     elif not _arc(interp, block, words, modal, motion, line):
         interp._arc(block, motion)
@@ -370,12 +451,11 @@ cdef bint _arc(object interp, object block, dict words, object modal,
     cdef double r, t0, t1, sweep, planar
     cdef str w1, w2
     cdef list start, end
-    cdef object key, feed, p
+    cdef object feed, p
     if modal.arc_distance == 901 or "r" in words:
         return False
     a1, a2, _, centre = _PLANES[modal.plane]
     w1, w2 = centre[0], centre[1]
-    key = code_key("g", motion / 10)
     start = interp.pos
     end = _target(interp, words, modal)
     s1, s2, e1, e2 = start[a1], start[a2], end[a1], end[a2]
@@ -383,7 +463,8 @@ cdef bint _arc(object interp, object block, dict words, object modal,
     tol = 0.005 if interp.machine_metric else 0.0005
     if w1 not in words and w2 not in words:
         raise block.error(f"{w1.upper()} and {w2.upper()} words both "
-                          "missing for a centre-format arc", key)
+                          "missing for a centre-format arc",
+                          code_key("g", motion / 10))
     o1 = <double>words.get(w1, 0.0) * k
     o2 = <double>words.get(w2, 0.0) * k
     c1 = s1 + o1
@@ -391,11 +472,11 @@ cdef bint _arc(object interp, object block, dict words, object modal,
     r1 = _hypot(s1 - c1, s2 - c2)
     r2 = _hypot(e1 - c1, e2 - c2)
     if r1 < 1e-9:
-        raise block.error("zero radius arc", key)
+        raise block.error("zero radius arc", code_key("g", motion / 10))
     if abs(r1 - r2) > tol and abs(r1 - r2) > 0.001 * r1:
         raise block.error(
             f"radius to end of arc differs from radius to start "
-            f"by {abs(r1 - r2) / k:.4g}", key)
+            f"by {abs(r1 - r2) / k:.4g}", code_key("g", motion / 10))
     turns = 1
     if "p" in words:
         p = words["p"]
@@ -427,7 +508,7 @@ cdef bint _arc(object interp, object block, dict words, object modal,
         feed = interp.feed
         if feed <= 0:
             raise block.error("feed move with zero feed rate", "")
-    _emit(interp, _ArcFeed(tuple(end), (c1, c2), modal.plane // 10, turn,
-                           feed, line))
+    _emit(interp, _arc_feed(tuple(end), (c1, c2), modal.plane // 10, turn,
+                            feed, line))
     interp.pos = end
     return True

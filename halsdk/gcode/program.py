@@ -10,7 +10,7 @@ from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from typing import BinaryIO, Optional, Union
 
-from ._fast import EMPTY, read_line
+from ._fast import EMPTY, read_line, set_file_lines
 from .block import Block, code_key
 from .errors import GCodeError
 from .expr import Expr, ParamRef, Where
@@ -153,6 +153,9 @@ class _FileLines:
             self._file.close()
             self._file = None
             self._next = 0
+
+
+set_file_lines(_FileLines)
 
 
 def _read_file(path: str) -> tuple[Union[_TextLines, _FileLines],
