@@ -46,7 +46,7 @@ def outcome(fn, block) -> object:
     return None
 
 
-@settings(max_examples=600, deadline=None)
+@settings(max_examples=300, deadline=None)
 @given(SETUP, MOVE)
 def test_plain_moves_take_the_general_path_s_way(setup: list[str],
                                                  move: tuple) -> None:
@@ -88,7 +88,7 @@ def test_fast_path_constants_are_the_interpreter_s() -> None:
 small = st.sampled_from(["0", "1", "-2.5", "0.1234", "3", "-0.75"])
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=200, deadline=None)
 @given(SETUP, st.sampled_from(["G2", "G3", ""]), small, small,
        st.sampled_from(["", " Z1", " Z-0.5 A3"]),
        st.sampled_from(["", " P2", " P1", " P0.5", " F120"]),

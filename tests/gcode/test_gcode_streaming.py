@@ -63,7 +63,7 @@ def outcome(fn, *args):
         return str(exc)
 
 
-@settings(max_examples=400, deadline=None)
+@settings(max_examples=250, deadline=None)
 @given(st.one_of(lines, numbered))
 def test_ascii_reader_reads_as_the_general_reader(text: str) -> None:
     assert text.isascii()
@@ -71,7 +71,7 @@ def test_ascii_reader_reads_as_the_general_reader(text: str) -> None:
         outcome(generic, text)
 
 
-@settings(max_examples=400, deadline=None)
+@settings(max_examples=250, deadline=None)
 @given(st.one_of(lines, numbered))
 def test_fast_words_are_those_of_the_lexer(text: str) -> None:
     simple = simple_words(text)
