@@ -66,20 +66,33 @@ class _Structure:
 #: Characters that may start an o-word or a '%' line: only lines holding
 #: one are read by the first pass over a program.
 _CANDIDATE = re.compile(r"[oO%]")
-_CANDIDATE_BYTES = re.compile(rb"[oO%]")
 #: Line ends that ``str.splitlines`` knows besides \n and \r\n: a file
 #: holding one is read whole (as text) rather than streamed.
 _OTHER_LINE_ENDS = (b"\x0b", b"\x0c", b"\x1c", b"\x1d", b"\x1e", b"\xc2\x85",
                     b"\xe2\x80\xa8", b"\xe2\x80\xa9")
 
 
-def _other_line_ends(chunk: bytes, end: int) -> bool:
+def _other_line_ends(chunk: bytes, end: int, ascii: bool) -> bool:
     """True if ``chunk[:end]`` holds a line end other than \\n and
-    \\r\\n."""
+    \\r\\n (``ascii``: it is all ASCII)."""
     if chunk.find(b"\r", 0, end) >= 0 and \
             chunk.count(b"\r", 0, end) != chunk.count(b"\r\n", 0, end):
         return True
-    return any(chunk.find(other, 0, end) >= 0 for other in _OTHER_LINE_ENDS)
+    others = _OTHER_LINE_ENDS[:5] if ascii else _OTHER_LINE_ENDS
+    return any(chunk.find(other, 0, end) >= 0 for other in others)
+
+
+def _candidates(chunk: bytes, end: int) -> Iterator[int]:
+    """The offsets of 'o', 'O' and '%' in ``chunk[:end]``, ascending
+    (bytes.find runs at memchr speed, a regular expression does not)."""
+    found = [(chunk.find(c, 0, end), c) for c in (b"o", b"O", b"%")]
+    heads = sorted((at, c) for at, c in found if at >= 0)
+    while heads:
+        at, c = heads.pop(0)
+        yield at
+        following = chunk.find(c, at + 1, end)
+        if following >= 0:
+            bisect.insort(heads, (following, c))
 #: Size of the pieces a program file is scanned in.
 _CHUNK = 1 << 20
 
@@ -190,14 +203,14 @@ def _read_file(path: str) -> tuple[Union[_TextLines, _FileLines],
                     cut = len(chunk)
                     rest = b""
                 # the lines of chunk[:cut], without copying them
-                if _other_line_ends(chunk, cut):
+                ascii = chunk.isascii()
+                if _other_line_ends(chunk, cut, ascii):
                     return _read_text(path)
-                if not chunk.isascii():
+                if not ascii:
                     chunk[:cut].decode("utf-8")  # the error a text read gives
                 counted = 0     # newlines before here are in ``index``
                 skip = 0        # the end of the last candidate line
-                for match in _CANDIDATE_BYTES.finditer(chunk, 0, cut):
-                    at = match.start()
+                for at in _candidates(chunk, cut):
                     if at < skip:
                         continue        # a second one on the same line
                     start = chunk.rfind(b"\n", 0, at) + 1
