@@ -59,6 +59,16 @@ def _code_name(number: float) -> str:
     return text or "0"
 
 
+_CODE_KEYS: dict[tuple[str, float], str] = {}
+
+
 def code_key(letter: str, number: float) -> str:
     """The ``columns`` key of a G or M code: ``code_key('g', 38.2) == 'g38.2'``."""
-    return letter.lower() + _code_name(number)
+    key = _CODE_KEYS.get((letter, number))
+    if key is None:
+        key = letter.lower() + _code_name(number)
+        # a few hundred codes are in use; 0 is not kept (-0.0 == 0.0 but
+        # its key is 'g-0')
+        if number and len(_CODE_KEYS) < 4096:
+            _CODE_KEYS[(letter, number)] = key
+    return key

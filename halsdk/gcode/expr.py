@@ -185,8 +185,7 @@ class Binary(Expr):
         except (OverflowError, ValueError, ZeroDivisionError) as exc:
             raise where.error(f"cannot compute {a:g} {self.op.upper()} "
                               f"{b:g}: {exc}", self.column) from None
-        if isinstance(result, complex) or math.isnan(result) \
-                or math.isinf(result):
+        if isinstance(result, complex) or not math.isfinite(result):
             raise where.error(f"{a:g} {self.op.upper()} {b:g} is not a real "
                               "number", self.column)
         return float(result)

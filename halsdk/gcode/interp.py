@@ -28,9 +28,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
-from typing import Any, Optional
+from typing import Any, Callable, Optional
 
 from . import canon as C
+from ._fast import fast_move
 from .block import Block, code_key
 from .cutter_radius import CutterComp, CutterRadiusError
 from .modal import AXIS_USERS_GROUP0, ModalState, group_codes
@@ -45,8 +46,12 @@ CANNED = (730, 810, 820, 830, 840, 850, 860, 880, 890)
 UNSUPPORTED_MOTION = {760: "G76", 870: "G87"}
 
 
+#: Letters every block may hold (the others need a code that uses them).
+ALWAYS_ALLOWED = frozenset(AXES + "fstno")
+
+
 def _pose(values: Any) -> C.Pose:
-    return tuple(float(v) for v in values)  # type: ignore[return-value]
+    return tuple(map(float, values))  # type: ignore[return-value]
 
 
 class Interpreter:
@@ -105,7 +110,7 @@ class Interpreter:
 
     def _g5x(self, index: int = 0) -> list[float]:
         base = 5201 + 20 * (index or self.coord_index)
-        return [self.params.get(base + i) for i in range(9)]
+        return self.params.numbered(base, 9)
 
     def program_position(self) -> list[float]:
         """Current position in program coordinates, machine units."""
@@ -129,13 +134,18 @@ class Interpreter:
                 if a in block.words:
                     end[i] = block.words[a] * self._k(i) + self.tlo[i]
             return end
-        prog = self.program_position()
+        # program_position() and _to_machine() with one reading of the
+        # offsets (the same arithmetic)
+        g5x, g92, tlo, pos = self._g5x(), self.g92, self.tlo, self.pos
+        prog = [pos[i] - g5x[i] - g92[i] - tlo[i] for i in range(9)]
         incremental = self.modal.distance == 910
+        words = block.words
+        k = self._k()
         for i, a in enumerate(AXES):
-            if a in block.words:
-                value = block.words[a] * self._k(i)
+            if a in words:
+                value = words[a] * (1.0 if i in ROTARY else k)
                 prog[i] = prog[i] + value if incremental else value
-        return self._to_machine(prog)
+        return [prog[i] + g5x[i] + g92[i] + tlo[i] for i in range(9)]
 
     def _emit(self, command: C.Command) -> None:
         if not self.comp.hold(command):
@@ -152,6 +162,15 @@ class Interpreter:
 
     def execute(self, block: Block) -> None:
         """Execute one block in the documented order of execution."""
+        # plain moves (most blocks of a CAM program) take a short path,
+        # compiled: it does what this method, _target, _straight_feed and
+        # _traverse do for them, so a change to those belongs there too
+        if fast_move(self, block):
+            return
+        self._execute(block)
+
+    def _execute(self, block: Block) -> None:
+        """:meth:`execute` without the short path of plain moves."""
         self.line = block.line
         self.line_block = block
         gs, ms = group_codes(block)
@@ -272,8 +291,13 @@ class Interpreter:
         if axes and not user0 and gs.get(8) != 431 and motion == 800:
             raise block.error(
                 f"{axes[0].upper()} word with no G code to use it", axes[0])
+        users: Optional[set[str]] = None
         for letter in block.words:
-            if letter not in self._word_users(block, gs, ms, motion):
+            if letter in ALWAYS_ALLOWED:
+                continue
+            if users is None:
+                users = self._word_users(block, gs, ms, motion)
+            if letter not in users:
                 raise block.error(f"{letter.upper()} word with no G or M "
                                   "code to use it", letter)
 
@@ -919,30 +943,34 @@ class Interpreter:
         if len(name) == 2 and name[1] in AXES:
             i = AXES.index(name[1])
             return self.program_position()[i] / self._k(i)
-        m = self.modal
-        table: dict[str, float] = {
-            "_feed": self.feed / self._k(),
-            "_rpm": self.speed,
-            "_metric": float(self.program_metric),
-            "_imperial": float(not self.program_metric),
-            "_absolute": float(m.distance == 900),
-            "_incremental": float(m.distance == 910),
-            "_inverse_time": float(m.feed_mode == 930),
-            "_units_per_minute": float(m.feed_mode == 940),
-            "_coord_system": float(m.coord_system),
-            "_motion_mode": float(m.motion),
-            "_plane": float(m.plane),
-            "_ccomp": float(m.cutter_comp),
-            "_tool_offset": float(m.tool_length != 490),
-            "_retract_r_plane": float(m.retract == 990),
-            "_retract_old_z": float(m.retract == 980),
-            "_spindle_on": float(m.spindle != 50),
-            "_spindle_cw": float(m.spindle == 30),
-            "_mist": float(m.mist),
-            "_flood": float(m.flood),
-            "_current_tool": float(self.current_tool),
-            "_selected_tool": float(self.selected_tool),
-            "_selected_pocket": float(self.selected_pocket),
-            "_line": float(self.line),
-        }
-        return table.get(name)
+        value = _PREDEFINED.get(name)
+        return None if value is None else value(self, self.modal)
+
+
+#: The read-only predefined named parameters: name -> its value, from the
+#: interpreter and its modal state (computed when the name is read).
+_PREDEFINED: dict[str, Callable[[Interpreter, ModalState], float]] = {
+    "_feed": lambda i, m: i.feed / i._k(),
+    "_rpm": lambda i, m: i.speed,
+    "_metric": lambda i, m: float(i.program_metric),
+    "_imperial": lambda i, m: float(not i.program_metric),
+    "_absolute": lambda i, m: float(m.distance == 900),
+    "_incremental": lambda i, m: float(m.distance == 910),
+    "_inverse_time": lambda i, m: float(m.feed_mode == 930),
+    "_units_per_minute": lambda i, m: float(m.feed_mode == 940),
+    "_coord_system": lambda i, m: float(m.coord_system),
+    "_motion_mode": lambda i, m: float(m.motion),
+    "_plane": lambda i, m: float(m.plane),
+    "_ccomp": lambda i, m: float(m.cutter_comp),
+    "_tool_offset": lambda i, m: float(m.tool_length != 490),
+    "_retract_r_plane": lambda i, m: float(m.retract == 990),
+    "_retract_old_z": lambda i, m: float(m.retract == 980),
+    "_spindle_on": lambda i, m: float(m.spindle != 50),
+    "_spindle_cw": lambda i, m: float(m.spindle == 30),
+    "_mist": lambda i, m: float(m.mist),
+    "_flood": lambda i, m: float(m.flood),
+    "_current_tool": lambda i, m: float(i.current_tool),
+    "_selected_tool": lambda i, m: float(i.selected_tool),
+    "_selected_pocket": lambda i, m: float(i.selected_pocket),
+    "_line": lambda i, m: float(i.line),
+}

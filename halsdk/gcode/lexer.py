@@ -8,6 +8,7 @@ errors point at the right place.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 from typing import Optional
 
@@ -124,6 +125,105 @@ class _Reader:
     def startswith(self, text: str) -> bool:
         return all(self.peek(i) == c for i, c in enumerate(text))
 
+    def column_at(self, index: int) -> int:
+        """The column of significant character ``index``."""
+        return self.chars[index][1]
+
+
+#: ASCII white space (what str.isspace() is true for)
+_SPACE = "[ \t\n\r\x0b\x0c\x1c-\x1f]"
+_SIGNIFICANT = re.compile(f"{_SPACE}*([^ \t\n\r\x0b\x0c\x1c-\x1f(;]*)")
+_NUMBER = re.compile(r"[+-]?[0-9.]*")
+_UNSIGNED = re.compile(r"[0-9.]*")
+_WORD = re.compile(r"[a-z]*")
+_OPERATOR = re.compile(r"\*\*|[*/+-]|mod|eq|ne|gt|ge|lt|le|and|or|xor")
+
+
+class _AsciiReader(_Reader):
+    """The reader of an ASCII line: the significant characters as one
+    string, so that numbers, names and operators are read with regular
+    expressions (what the character loops of the other reader read)."""
+
+    def __init__(self, text: str, columns: list[int], file: str, line: int,
+                 end_column: int) -> None:
+        self.text = text
+        self.columns = columns
+        self.size = len(text)
+        self.pos = 0
+        self.file = file
+        self.line = line
+        self.end_column = end_column
+
+    def peek(self, offset: int = 0) -> str:
+        index = self.pos + offset
+        return self.text[index] if index < self.size else ""
+
+    def column(self) -> int:
+        if self.pos < self.size:
+            return self.columns[self.pos]
+        return self.end_column
+
+    def take(self) -> str:
+        pos = self.pos
+        self.pos = pos + 1
+        return self.text[pos] if pos < self.size else ""
+
+    def at_end(self) -> bool:
+        return self.pos >= self.size
+
+    def startswith(self, text: str) -> bool:
+        return self.text.startswith(text, self.pos)
+
+    def column_at(self, index: int) -> int:
+        return self.columns[index]
+
+    def match(self, pattern: re.Pattern[str]) -> str:
+        """The text ``pattern`` matches at the cursor (it always
+        matches), consumed."""
+        match = pattern.match(self.text, self.pos)
+        assert match is not None
+        self.pos = match.end()
+        return match.group()
+
+
+def _strip_ascii(text: str, file: str, lineno: int
+                 ) -> tuple[str, list[int], list[Comment]]:
+    """:func:`_strip` of an ASCII line: the significant characters
+    (lower case) as one string, their columns, the comments."""
+    parts: list[str] = []
+    columns: list[int] = []
+    comments: list[Comment] = []
+    i = 0
+    size = len(text)
+    significant = _SIGNIFICANT.match
+    while i < size:
+        run = significant(text, i)
+        assert run is not None
+        start, end = run.span(1)
+        if end > start:
+            parts.append(run.group(1))
+            columns.extend(range(start + 1, end + 1))
+        i = end
+        if i >= size:
+            break
+        char = text[i]
+        if char == "(":
+            end = text.find(")", i + 1)
+            if end < 0:
+                raise GCodeError("unclosed comment: '(' without ')'",
+                                 file, lineno, i + 1)
+            nested = text.find("(", i + 1, end)
+            if nested >= 0:
+                raise GCodeError("nested comment: '(' inside a comment",
+                                 file, lineno, nested + 1)
+            comments.append(_comment(text[i + 1:end], i + 1))
+            i = end + 1
+        elif char == ";":
+            comments.append(Comment(text[i + 1:].strip(), "", i + 1))
+            break
+        # else white space: the next search skips it
+    return "".join(parts).lower(), columns, comments
+
 
 def _strip(text: str, file: str, lineno: int
            ) -> tuple[list[tuple[str, int]], list[Comment]]:
@@ -165,9 +265,20 @@ def _comment(body: str, column: int) -> Comment:
 
 def parse_line(text: str, file: str = "<string>", lineno: int = 1) -> Line:
     """Read one line of G-code; raises :class:`GCodeError` with its column."""
-    chars, comments = _strip(text.rstrip("\r\n"), file, lineno)
-    line = Line(file, lineno, text.rstrip("\r\n"), comments=comments)
-    reader = _Reader(chars, file, lineno, len(text.rstrip("\r\n")) + 1)
+    text = text.rstrip("\r\n")
+    reader: _Reader
+    if text.isascii():
+        significant, columns, comments = _strip_ascii(text, file, lineno)
+        reader = _AsciiReader(significant, columns, file, lineno,
+                              len(text) + 1)
+    else:
+        chars, comments = _strip(text, file, lineno)
+        reader = _Reader(chars, file, lineno, len(text) + 1)
+    return _read_line(reader, Line(file, lineno, text, comments=comments))
+
+
+def _read_line(reader: _Reader, line: Line) -> Line:
+    """The words, assignments and o-word of ``line`` from ``reader``."""
     if reader.peek() == "%":
         reader.take()
         if not reader.at_end():
@@ -219,9 +330,12 @@ def parse_line(text: str, file: str = "<string>", lineno: int = 1) -> Line:
 
 def _unsigned_number(reader: _Reader) -> float:
     start = reader.column()
-    digits = ""
-    while reader.peek().isdigit() or reader.peek() == ".":
-        digits += reader.take()
+    if isinstance(reader, _AsciiReader):
+        digits = reader.match(_UNSIGNED)
+    else:
+        digits = ""
+        while reader.peek().isdigit() or reader.peek() == ".":
+            digits += reader.take()
     try:
         return float(digits)
     except ValueError:
@@ -231,6 +345,12 @@ def _unsigned_number(reader: _Reader) -> float:
 def _number(reader: _Reader) -> Number:
     """A decimal number with optional sign: ``-1.5``, ``+.25``, ``3``."""
     start = reader.column()
+    if isinstance(reader, _AsciiReader):
+        pos = reader.pos
+        text = reader.match(_NUMBER)
+        if text.count(".") < 2 and any(c.isdigit() for c in text):
+            return Number(float(text), start)
+        reader.pos = pos            # the loop below says what is wrong
     text = ""
     if reader.peek() and reader.peek() in "+-":
         text += reader.take()
@@ -241,7 +361,7 @@ def _number(reader: _Reader) -> Number:
         if char == ".":
             if seen_dot:
                 raise reader.error("bad number: a second decimal point",
-                                   reader.chars[reader.pos - 1][1])
+                                   reader.column_at(reader.pos - 1))
             seen_dot = True
         else:
             digits += 1
@@ -293,6 +413,9 @@ def _bracketed(reader: _Reader) -> Expr:
 
 
 def _operator(reader: _Reader) -> Optional[str]:
+    if isinstance(reader, _AsciiReader):
+        match = _OPERATOR.match(reader.text, reader.pos)
+        return match.group() if match is not None else None
     if reader.startswith("**"):
         return "**"
     if reader.peek() in ("*", "/", "+", "-"):
@@ -320,9 +443,12 @@ def _expression(reader: _Reader, min_precedence: int) -> Expr:
 
 def _function(reader: _Reader) -> Expr:
     column = reader.column()
-    name = ""
-    while reader.peek().isalpha():
-        name += reader.take()
+    if isinstance(reader, _AsciiReader):
+        name = reader.match(_WORD)
+    else:
+        name = ""
+        while reader.peek().isalpha():
+            name += reader.take()
     if name == "atan":
         if reader.peek() != "[":
             raise reader.error("ATAN needs [y]/[x]")
@@ -360,9 +486,15 @@ def _name(reader: _Reader) -> str:
     """``<name>`` (the cursor is on '<'): lower case, no spaces."""
     open_column = reader.column()
     reader.take()
-    name = ""
-    while not reader.at_end() and reader.peek() != ">":
-        name += reader.take()
+    if isinstance(reader, _AsciiReader):
+        end = reader.text.find(">", reader.pos)
+        end = reader.size if end < 0 else end
+        name = reader.text[reader.pos:end]
+        reader.pos = end
+    else:
+        name = ""
+        while not reader.at_end() and reader.peek() != ">":
+            name += reader.take()
     if reader.at_end():
         raise reader.error("unclosed parameter name: '<' without '>'",
                            open_column)
@@ -403,9 +535,12 @@ def _oword(reader: _Reader) -> OWord:
     else:
         raise reader.error("expected an o-word number or <name> after 'O'")
     keyword_column = reader.column()
-    keyword = ""
-    while reader.peek().isalpha():
-        keyword += reader.take()
+    if isinstance(reader, _AsciiReader):
+        keyword = reader.match(_WORD)
+    else:
+        keyword = ""
+        while reader.peek().isalpha():
+            keyword += reader.take()
     if keyword not in O_KEYWORDS:
         text = f"'{keyword}'" if keyword else "nothing"
         raise reader.error(f"unknown o-word keyword {text}", keyword_column)

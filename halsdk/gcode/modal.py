@@ -63,7 +63,7 @@ def _by_group(block: Block, letter: str, values: Iterable[float],
     found: dict[int, int] = {}
     word = letter.upper()
     for value in values:
-        code = _key(value)
+        code = int(round(value * 10))
         name = code_key(letter, value)
         if code not in groups:
             raise block.error(f"unknown or unsupported {word} code "

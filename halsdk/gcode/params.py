@@ -23,9 +23,17 @@ LOCAL_NUMBERED = range(1, 31)
 Key = Union[int, str]
 
 
+_NORMALIZED: dict[str, str] = {}
+
+
 def normalize_name(name: str) -> str:
     """Lower-case a parameter name and drop its spaces and tabs."""
-    return "".join(name.split()).lower()
+    normal = _NORMALIZED.get(name)
+    if normal is None:
+        normal = "".join(name.split()).lower()
+        if len(_NORMALIZED) < 4096:     # the names of a few programs
+            _NORMALIZED[name] = normal
+    return normal
 
 
 class _Frame:
@@ -126,6 +134,15 @@ class Parameters:
         if number in LOCAL_NUMBERED and self.depth:
             return self._frames[-1].numbered.get(number, 0.0)
         return self._numbered.get(number, 0.0)
+
+    def numbered(self, first: int, count: int) -> list[float]:
+        """``#first`` .. ``#first+count-1`` (unset ones read 0), numbers
+        above the subroutine locals: what ``get`` reads for them, faster
+        (the interpreter reads offsets nine at a time)."""
+        if first <= LOCAL_NUMBERED[-1] or first + count - 1 > MAX_PARAMETER:
+            return [self.get(n) for n in range(first, first + count)]
+        get = self._numbered.get
+        return [get(n, 0.0) for n in range(first, first + count)]
 
     def set(self, key: Key, value: float) -> None:
         """Store ``value`` in parameter ``key`` (in the current scope)."""

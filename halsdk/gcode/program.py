@@ -2,13 +2,15 @@
 
 from __future__ import annotations
 
+import bisect
 import os
 import re
 import time
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
-from typing import Optional
+from typing import BinaryIO, Optional, Union
 
+from ._fast import EMPTY, read_line, set_file_lines
 from .block import Block, code_key
 from .errors import GCodeError
 from .expr import Expr, ParamRef, Where
@@ -48,26 +50,265 @@ class _Structure:
     loop_start: dict[int, int] = field(default_factory=dict)
     # break/continue -> loop opener
     loop_of: dict[int, int] = field(default_factory=dict)
-    # line index -> the sub it belongs to
-    sub_of: dict[int, str] = field(default_factory=dict)
+    # the line ranges of the subroutine definitions (first, last), sorted
+    sub_starts: list[int] = field(default_factory=list)
+    sub_ends: list[int] = field(default_factory=list)
+
+    def sub_end(self, index: int) -> int:
+        """The endsub line of the definition line ``index`` is in, or -1
+        when it is in none."""
+        at = bisect.bisect_right(self.sub_starts, index) - 1
+        if at >= 0 and index <= self.sub_ends[at]:
+            return self.sub_ends[at]
+        return -1
+
+
+#: Characters that may start an o-word or a '%' line: only lines holding
+#: one are read by the first pass over a program.
+_CANDIDATE = re.compile(r"[oO%]")
+#: Line ends that ``str.splitlines`` knows besides \n and \r\n: a file
+#: holding one is read whole (as text) rather than streamed.
+_OTHER_LINE_ENDS = (b"\x0b", b"\x0c", b"\x1c", b"\x1d", b"\x1e", b"\xc2\x85",
+                    b"\xe2\x80\xa8", b"\xe2\x80\xa9")
+
+
+def _other_line_ends(chunk: bytes, end: int, ascii: bool) -> bool:
+    """True if ``chunk[:end]`` holds a line end other than \\n and
+    \\r\\n (``ascii``: it is all ASCII)."""
+    if chunk.find(b"\r", 0, end) >= 0 and \
+            chunk.count(b"\r", 0, end) != chunk.count(b"\r\n", 0, end):
+        return True
+    others = _OTHER_LINE_ENDS[:5] if ascii else _OTHER_LINE_ENDS
+    return any(chunk.find(other, 0, end) >= 0 for other in others)
+
+
+def _candidates(chunk: bytes, end: int) -> Iterator[int]:
+    """The offsets of 'o', 'O' and '%' in ``chunk[:end]``, ascending
+    (bytes.find runs at memchr speed, a regular expression does not)."""
+    found = [(chunk.find(c, 0, end), c) for c in (b"o", b"O", b"%")]
+    heads = sorted((at, c) for at, c in found if at >= 0)
+    while heads:
+        at, c = heads.pop(0)
+        yield at
+        following = chunk.find(c, at + 1, end)
+        if following >= 0:
+            bisect.insort(heads, (following, c))
+#: Size of the pieces a program file is scanned in.
+_CHUNK = 1 << 20
+
+#: A read line: the fast path's (text, N number, words), a :class:`Line`,
+#: or the error of a line that cannot be read (raised when reached).
+_Entry = Union[tuple, Line, GCodeError]
+
+
+class _TextLines:
+    """The lines of a program held in memory."""
+
+    def __init__(self, lines: list[str]) -> None:
+        self.lines = lines
+        self.count = len(lines)
+
+    def line(self, index: int) -> Optional[str]:
+        return self.lines[index] if index < self.count else None
+
+    def close(self) -> None:
+        pass
+
+
+class _FileLines:
+    """The lines of a program file, read as they are needed: sequential
+    reads go on from where the last one stopped; a jump seeks to the
+    nearest line whose offset the first pass kept (the o-word lines) and
+    reads on from there, as the reference reads a program.  Memory does
+    not grow with the length of the file."""
+
+    def __init__(self, path: str, offsets: dict[int, int],
+                 count: int) -> None:
+        self.path = path
+        self.offsets = offsets
+        self.known = sorted(offsets)
+        self.count = count
+        self._file: Optional[BinaryIO] = None
+        self._next = 0
+
+    def line(self, index: int) -> Optional[str]:
+        if index >= self.count:
+            return None
+        stream = self._file
+        if stream is None or index != self._next:
+            stream = self._seek(index)
+        raw = stream.readline()
+        self._next = index + 1
+        return raw.decode("utf-8").rstrip("\r\n")
+
+    def _seek(self, index: int) -> BinaryIO:
+        stream = self._file
+        if stream is None:
+            try:
+                stream = self._file = open(self.path, "rb")
+            except OSError as exc:
+                raise GCodeError(f"cannot read program: {exc.strerror}",
+                                 self.path) from None
+        if index == self._next:
+            return stream
+        if index in self.offsets:
+            start = index
+        else:
+            start = self.known[bisect.bisect_right(self.known, index) - 1]
+        stream.seek(self.offsets[start])
+        for _ in range(index - start):
+            stream.readline()
+        self._next = index
+        return stream
+
+    def close(self) -> None:
+        if self._file is not None:
+            self._file.close()
+            self._file = None
+            self._next = 0
+
+
+set_file_lines(_FileLines)
+
+
+def _read_file(path: str) -> tuple[Union[_TextLines, _FileLines],
+                                   list[tuple[int, str]]]:
+    """The lines of the program file ``path`` and the candidate lines of
+    the first pass, ``(index, text)``.
+
+    One pass over the file in pieces of :data:`_CHUNK` bytes keeps the
+    byte offset of every line that may be an o-word or '%' line; the
+    file is not held in memory.  A file with line ends other than \\n
+    and \\r\\n is read whole, as text.
+    """
+    candidates: list[tuple[int, str]] = []
+    offsets = {0: 0}
+    index = 0           # lines before ``base``
+    base = 0            # file offset of ``chunk``
+    try:
+        with open(path, "rb") as stream:
+            rest = b""
+            while True:
+                piece = stream.read(_CHUNK)
+                chunk = rest + piece
+                if piece:
+                    cut = chunk.rfind(b"\n") + 1
+                    if cut == 0:
+                        rest = chunk
+                        continue
+                    rest = chunk[cut:]
+                elif not chunk:
+                    break
+                else:
+                    cut = len(chunk)
+                    rest = b""
+                # the lines of chunk[:cut], without copying them
+                ascii = chunk.isascii()
+                if _other_line_ends(chunk, cut, ascii):
+                    return _read_text(path)
+                if not ascii:
+                    chunk[:cut].decode("utf-8")  # the error a text read gives
+                counted = 0     # newlines before here are in ``index``
+                skip = 0        # the end of the last candidate line
+                for at in _candidates(chunk, cut):
+                    if at < skip:
+                        continue        # a second one on the same line
+                    start = chunk.rfind(b"\n", 0, at) + 1
+                    stop = chunk.find(b"\n", at, cut)
+                    stop = cut if stop < 0 else stop
+                    index += chunk.count(b"\n", counted, start)
+                    counted = start
+                    offsets[index] = base + start
+                    candidates.append(
+                        (index, chunk[start:stop].decode("utf-8")
+                         .rstrip("\r\n")))
+                    skip = stop + 1
+                index += chunk.count(b"\n", counted, cut)
+                if chunk[cut - 1] != 10:
+                    index += 1          # a last line without its line end
+                base += cut
+                if not piece:
+                    break
+    except OSError as exc:
+        raise GCodeError(f"cannot read program: {exc.strerror}",
+                         path) from None
+    return _FileLines(path, offsets, index), candidates
+
+
+def _read_text(path: str) -> tuple[_TextLines, list[tuple[int, str]]]:
+    try:
+        with open(path, encoding="utf-8") as stream:
+            text = stream.read()
+    except OSError as exc:
+        raise GCodeError(f"cannot read program: {exc.strerror}",
+                         path) from None
+    return _text_lines(text)
+
+
+def _text_lines(text: str) -> tuple[_TextLines, list[tuple[int, str]]]:
+    lines = text.splitlines()
+    search = _CANDIDATE.search
+    return _TextLines(lines), [(i, t) for i, t in enumerate(lines)
+                               if search(t)]
 
 
 class _Unit:
-    """One source file (or string): its lines and their structure."""
+    """One source file (or string): its o-word lines, their structure,
+    and the other lines read as the run reaches them.
 
-    def __init__(self, text: str, file: str) -> None:
+    Only the o-word and '%' lines are kept from the first pass; the lines
+    of loops and subroutine definitions are kept once read (they are read
+    again); the others are read and dropped, so a long program runs in
+    constant memory.
+    """
+
+    def __init__(self, source: Union[_TextLines, _FileLines], file: str,
+                 candidates: list[tuple[int, str]]) -> None:
         self.file = file
-        self.lines: list[Line | GCodeError] = []
-        for number, source in enumerate(text.splitlines(), start=1):
+        self.source = source
+        self.owords: dict[int, Line] = {}
+        self.percents: list[int] = []
+        for index, text in candidates:
             try:
-                self.lines.append(parse_line(source, file, number))
-            except GCodeError as exc:
-                self.lines.append(exc)
+                line = parse_line(text, file, index + 1)
+            except GCodeError:
+                continue            # raised when the run reaches it
+            if line.oword is not None:
+                self.owords[index] = line
+            elif line.percent:
+                self.percents.append(index)
         self.structure = _scan(self)
+        # the line ranges read more than once: loops and subroutines
+        spans = sorted([(a, b) for a, b in self.structure.loop_end.items()]
+                       + list(self.structure.subs.values()))
+        self._keep_starts: list[int] = []
+        self._keep_ends: list[int] = []
+        for first, last in spans:
+            if self._keep_ends and first <= self._keep_ends[-1]:
+                self._keep_ends[-1] = max(self._keep_ends[-1], last)
+            else:
+                self._keep_starts.append(first)
+                self._keep_ends.append(last)
+        self._kept: dict[int, _Entry] = {}
+
+    @classmethod
+    def from_text(cls, text: str, file: str) -> _Unit:
+        source, candidates = _text_lines(text)
+        return cls(source, file, candidates)
+
+    @classmethod
+    def from_file(cls, path: str) -> _Unit:
+        source, candidates = _read_file(path)
+        return cls(source, path, candidates)
+
+    @property
+    def count(self) -> int:
+        """The number of lines."""
+        return self.source.count
 
     def oword(self, index: int) -> Optional[OWord]:
-        line = self.lines[index]
-        return line.oword if isinstance(line, Line) else None
+        line = self.owords.get(index)
+        return line.oword if line is not None else None
 
     def keyword(self, index: int) -> str:
         """The keyword of line ``index``, which the scan found an o-word."""
@@ -76,6 +317,9 @@ class _Unit:
             raise RuntimeError(f"{self.file}: line {index + 1} is not an "
                                "o-word")
         return oword.keyword
+
+    def close(self) -> None:
+        self.source.close()
 
 
 def _name_text(oword: OWord) -> str:
@@ -94,16 +338,13 @@ def _scan(unit: _Unit) -> _Structure:
     current_sub: Optional[tuple[str, int]] = None
 
     def fail(index: int, message: str) -> GCodeError:
-        line = unit.lines[index]
-        assert isinstance(line, Line) and line.oword is not None
+        line = unit.owords[index]
+        assert line.oword is not None
         return GCodeError(message, unit.file, line.number, line.oword.column)
 
-    for index in range(len(unit.lines)):
-        oword = unit.oword(index)
-        if current_sub is not None:
-            result.sub_of[index] = current_sub[0]
-        if oword is None:
-            continue
+    for index in sorted(unit.owords):
+        oword = unit.owords[index].oword
+        assert oword is not None
         name, keyword = _name_text(oword), oword.keyword
         label = _label(name)
         if keyword == "sub":
@@ -113,7 +354,6 @@ def _scan(unit: _Unit) -> _Structure:
             if name in result.subs:
                 raise fail(index, f"{label} sub defined twice")
             current_sub = (name, index)
-            result.sub_of[index] = name
         elif keyword == "endsub":
             if current_sub is None:
                 raise fail(index, f"{label} endsub without sub")
@@ -125,6 +365,8 @@ def _scan(unit: _Unit) -> _Structure:
                 raise fail(index, f"{label} endsub does not match "
                                   f"o<{current_sub[0]}> sub")
             result.subs[name] = (current_sub[1], index)
+            result.sub_starts.append(current_sub[1])
+            result.sub_ends.append(index)
             current_sub = None
         elif keyword == "return":
             if current_sub is None or current_sub[0] != name:
@@ -236,7 +478,7 @@ class Program:
         self.iterations = 0
         self._idle_since = 0.0
         self._frames: list[_Frame] = []
-        self._main = _Unit(text, file)
+        self._main = _Unit.from_text(text, file)
         self._files: dict[str, _Unit] = {}
 
     @classmethod
@@ -244,16 +486,20 @@ class Program:
                   search_path: Sequence[str] = (), **options: object
                   ) -> Program:
         """Read a program file; its directory is searched for subroutine
-        files after ``search_path``."""
-        try:
-            with open(path, encoding="utf-8") as stream:
-                text = stream.read()
-        except OSError as exc:
-            raise GCodeError(f"cannot read program: {exc.strerror}",
-                             path) from None
+        files after ``search_path``.
+
+        The file is streamed: a first pass keeps only where its o-word
+        lines are (and checks their structure, as :class:`Program` does);
+        :meth:`blocks` then reads the lines as the run reaches them, so a
+        program of any length starts at once and runs in constant memory.
+        The file must not change while the program runs.
+        """
+        unit = _Unit.from_file(path)
         directory = os.path.dirname(os.path.abspath(path))
-        return cls(text, path, params, [*search_path, directory],
-                   **options)  # type: ignore[arg-type]
+        program = cls("", path, params, [*search_path, directory],
+                      **options)  # type: ignore[arg-type]
+        program._main = unit
+        return program
 
     # -- subroutine lookup -----------------------------------------------
     def _find_sub(self, name: str, unit: _Unit) -> Optional[_Unit]:
@@ -271,7 +517,7 @@ class Program:
                 except OSError as exc:
                     raise GCodeError(f"cannot read subroutine file: "
                                      f"{exc.strerror}", path) from None
-                loaded = _Unit(text, path)
+                loaded = _Unit.from_text(text, path)
                 if name not in loaded.structure.subs:
                     raise GCodeError(f"file defines no o<{name}> sub", path,
                                      1, 1)
@@ -306,8 +552,10 @@ class Program:
         block = Block(line.file, line.number, line.text,
                       block_delete=line.block_delete,
                       line_number=line.line_number)
+        params = self.params
+        where = Where(line.file, line.number)
         for word in line.words:
-            value = self._value(word.value, line)
+            value = word.value.evaluate(params, where)
             if word.letter in "gm":
                 value = round(value, 4)
                 key = code_key(word.letter, value)
@@ -318,7 +566,7 @@ class Program:
                 block.words[word.letter] = value
                 block.columns[word.letter] = word.column
         values = [(self._parameter_key(a.target, line),
-                   self._value(a.value, line), a.column)
+                   a.value.evaluate(params, where), a.column)
                   for a in line.assignments]
         for param, value, column in values:
             self._set(param, value, line, column)
@@ -352,6 +600,9 @@ class Program:
             yield from self._run()
         finally:
             self.params.reset_scopes()
+            self._main.close()
+            for unit in self._files.values():
+                unit.close()
 
     def _run(self) -> Iterator[Block]:
         unit = self._main
@@ -361,26 +612,41 @@ class Program:
         repeats: dict[tuple[int, int], int] = {}
         seen_code = False
         clock = self.clock
+        structure = unit.structure
         while True:
-            if index >= len(unit.lines):
+            entry = read_line(unit, index)
+            if entry is None:
                 if frames:  # pragma: no cover - the scan rules it out
                     raise GCodeError(
                         f"end of file inside {_label(frames[-1].name)}",
-                        unit.file, len(unit.lines), 1)
+                        unit.file, unit.count, 1)
                 return
-            entry = unit.lines[index]
+            if not frames and structure.sub_starts:
+                end = structure.sub_end(index)
+                if end >= 0:
+                    # a subroutine definition met in the main flow: skip it
+                    index = end + 1
+                    continue
+            if entry.__class__ is Block:
+                # the fast path: a line of plain numbered words
+                index += 1
+                seen_code = True
+                clock()
+                yield entry
+                self._idle_since = clock()
+                if entry.m and any(abs(m - 2) < 1e-6 or abs(m - 30) < 1e-6
+                                   for m in entry.m):
+                    return
+                continue
+            if entry is EMPTY:
+                index += 1
+                continue
             if isinstance(entry, GCodeError):
                 raise entry
+            assert isinstance(entry, Line)
             line = entry
-            structure = unit.structure
-            if not frames and index in structure.sub_of:
-                # a subroutine definition met in the main flow: skip it
-                index = structure.subs[structure.sub_of[index]][1] + 1
-                continue
             if line.percent:
-                if seen_code or index > 0 and any(
-                        isinstance(x, Line) and x.percent
-                        for x in unit.lines[:index]):
+                if seen_code or unit.percents and unit.percents[0] < index:
                     return
                 index += 1
                 continue
@@ -432,6 +698,7 @@ class Program:
                 self.params.push_scope(args)
                 frames.append(_Frame(unit, index + 1, name))
                 unit = target
+                structure = unit.structure
                 index = target.structure.subs[name][0] + 1
             elif keyword in ("return", "endsub"):
                 if keyword == "endsub" and not frames:
@@ -449,6 +716,7 @@ class Program:
                 else:
                     self.params.set("_value_returned", 0.0)
                 unit, index = frame.return_unit, frame.return_index
+                structure = unit.structure
             elif keyword == "sub":
                 index = structure.subs[_name_text(oword)][1] + 1
             elif keyword == "if":
@@ -528,8 +796,8 @@ class Program:
 
     @staticmethod
     def _runaway(unit: _Unit, index: int, message: str) -> GCodeError:
-        line = unit.lines[index]
-        assert isinstance(line, Line) and line.oword is not None
+        line = unit.owords[index]
+        assert line.oword is not None
         return GCodeError(message, line.file, line.number,
                           line.oword.column)
 
@@ -540,8 +808,8 @@ class Program:
         if self._value(oword.args[0], line):
             return index + 1
         for branch in unit.structure.branches[index]:
-            entry = unit.lines[branch]
-            assert isinstance(entry, Line) and entry.oword is not None
+            entry = unit.owords[branch]
+            assert entry.oword is not None
             keyword = entry.oword.keyword
             if keyword == "else":
                 return branch + 1
