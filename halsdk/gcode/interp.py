@@ -27,6 +27,7 @@ Conventions
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import replace
 from typing import Any, Optional
 
@@ -34,6 +35,36 @@ from . import canon as C
 from .block import Block, code_key
 from .cutter_radius import CutterComp, CutterRadiusError
 from .modal import AXIS_USERS_GROUP0, ModalState, group_codes
+
+_DEBUG_PARAM = re.compile(r"#\s*<([^>]*)>|#\s*(\d+)")
+
+
+def last_comment(text: str) -> Optional[tuple[str, str]]:
+    """The last ``( )`` comment of a line as ``(kind, text)``: kind is
+    'msg', 'debug', 'print' or '' (plain); the text after the comma is
+    kept as written.  ``;`` ends the scan (the reference does not report
+    ``;`` comments)."""
+    found: Optional[tuple[str, str]] = None
+    i = 0
+    while i < len(text):
+        char = text[i]
+        if char == ";":
+            break
+        if char == "(":
+            end = text.find(")", i + 1)
+            if end < 0:
+                break
+            body = text[i + 1:end]
+            head, comma, rest = body.partition(",")
+            kind = "".join(head.split()).lower()
+            if comma and kind in ("msg", "debug", "print"):
+                found = (kind, rest)
+            else:
+                found = ("", body)
+            i = end + 1
+            continue
+        i += 1
+    return found
 
 AXES = "xyzabcuvw"
 ROTARY = (3, 4, 5)
@@ -53,15 +84,22 @@ class Interpreter:
     """Executes :class:`~halsdk.gcode.block.Block` objects one at a time."""
 
     def __init__(self, params: Any, tools: Any, canon: C.Canon, *,
-                 random_toolchanger: bool = False, units: str = "mm") -> None:
-        if units not in ("mm", "inch"):
-            raise ValueError(f"units must be 'mm' or 'inch', not {units!r}")
+                 random_toolchanger: bool = False, units: str = "mm",
+                 program_units: Optional[str] = None) -> None:
+        program_units = program_units or units
+        for value in (units, program_units):
+            if value not in ("mm", "inch"):
+                raise ValueError(
+                    f"units must be 'mm' or 'inch', not {value!r}")
         self.params = params
         self.tools = tools
         self.canon = canon
+        #: emit the reference's informational calls (COMMENT, START_CHANGE
+        #: ...) as Trace commands: only for canons that ask for them
+        self.ref = bool(getattr(canon, "reference_calls", False))
         self.random = random_toolchanger
         self.machine_metric = units == "mm"
-        self.modal = ModalState(units=210 if self.machine_metric else 200)
+        self.modal = ModalState(units=210 if program_units == "mm" else 200)
         self.pos = [0.0] * 9
         self.tlo = [0.0] * 9
         self.g92 = [0.0] * 9
@@ -78,6 +116,8 @@ class Interpreter:
             self.current_tool = int(spindle.tool)
         self.selected_tool = -1
         self.selected_pocket = -1
+        self.diameter_mode = False
+        self.blend: tuple[Optional[float], Optional[float]] = (None, None)
         self.cycle: dict[str, float] = {}
         self.line = 0
         self.ended = False
@@ -141,6 +181,36 @@ class Interpreter:
         if not self.comp.hold(command):
             self.canon.emit(command)
 
+    def _trace(self, text: str, kind: str = "call") -> None:
+        """A reference-only call (see :class:`canon.Trace`)."""
+        if self.ref:
+            self._emit(C.Trace(text, kind, self.line))
+
+    def _comment_trace(self, block: Block) -> None:
+        """The last comment of the line, as the reference reports it."""
+        found = last_comment(block.text)
+        if found is None:
+            return
+        kind, text = found
+        if kind == "":
+            self._trace(f'COMMENT("{text}")')
+        elif kind == "msg":
+            self._trace(f'MESSAGE("{text}")')
+        elif kind == "debug":
+            self._trace(f'MESSAGE("{self._substitute(text)}")')
+        else:
+            self._trace(self._substitute(text), "print")
+
+    def _substitute(self, text: str) -> str:
+        def one(match: re.Match[str]) -> str:
+            key: Any = (match.group(1) if match.group(1) is not None
+                        else int(match.group(2)))
+            try:
+                return f"{self.params.get(key):.6f}"
+            except Exception:
+                return "######"
+        return _DEBUG_PARAM.sub(one, text)
+
     # -- public API ------------------------------------------------------
     def run(self, program: Any) -> None:
         """Execute every block of ``program`` until it ends."""
@@ -157,24 +227,33 @@ class Interpreter:
         gs, ms = group_codes(block)
         self._check(block, gs, ms)
         line = block.line
-        if block.message:
+        ref = self.ref
+        if ref:
+            self._comment_trace(block)
+        elif block.message:
             self._emit(C.Message(block.message, line))
         if 5 in gs:
-            self.modal.feed_mode = gs[5]
-            self._emit(C.SetFeedMode(
-                "inverse_time" if gs[5] == 930 else "units_per_minute", line))
-        if "f" in block.words and self.modal.feed_mode == 940:
+            self._feed_mode(block, gs[5])
+        if "f" in block.words:
             f = block.words["f"]
             if f < 0:
                 raise block.error("negative feed rate", "f")
-            self.feed = self._len(f)
-            self._emit(C.SetFeedRate(self.feed, line))
+            if ref:
+                self._trace(f"SET_FEED_RATE({f:.4f})")
+                if self.modal.feed_mode != 930:
+                    self.feed = self._len(f)
+            elif self.modal.feed_mode == 940:
+                self.feed = self._len(f)
+                self._emit(C.SetFeedRate(self.feed, line))
         if "s" in block.words:
             s = block.words["s"]
             if s < 0:
                 raise block.error("negative spindle speed", "s")
             self.speed = s
-            self._emit(C.SpindleSpeed(s, line))
+            if ref:
+                self._trace(f"SET_SPINDLE_SPEED(0, {s:.4f})")
+            else:
+                self._emit(C.SpindleSpeed(s, line))
         if "t" in block.words:
             self._select_tool(block)
         if 5 in ms:
@@ -182,13 +261,18 @@ class Interpreter:
         if 6 in ms:
             self._tool_change(block, ms[6])
         if 7 in ms:
-            self._spindle(ms[7], line)
+            if ms[7] == 190:
+                self._orient(block)
+            else:
+                self._spindle(ms[7], line)
         if 8 in ms:
             code = ms[8]
             self.modal.mist = code == 70 or (self.modal.mist and code != 90)
             self.modal.flood = code == 80 or (self.modal.flood and code != 90)
             self._emit(C.Coolant({70: "mist", 80: "flood", 90: "off"}[code],
                                  line))
+        if 9 in ms:
+            self._overrides(block, ms[9])
         if gs.get(0) == 40:
             p = self._need(block, "p", "G4")
             if p < 0:
@@ -199,23 +283,51 @@ class Interpreter:
             self._emit(C.SetPlane(gs[2] // 10, line))
         if 6 in gs:
             self.modal.units = gs[6]
+            self._trace("USE_LENGTH_UNITS(CANON_UNITS_"
+                        f"{'MM' if gs[6] == 210 else 'INCHES'})")
         if 7 in gs:
             self._cutter_comp(block, gs[7])
         if 8 in gs:
             self._tool_length(block, gs[8])
         if 12 in gs:
-            self.modal.coord_system = gs[12]
-            self.params.set(5220, self.coord_index)
-            self._emit(C.SetG5xOffset(self.coord_index, _pose(self._g5x()),
-                                      line))
+            if ref and gs[12] == self.modal.coord_system:
+                self._trace('COMMENT("interpreter: continuing to use same '
+                            'coordinate system")')
+            else:
+                self.modal.coord_system = gs[12]
+                self.params.set(5220, self.coord_index)
+                self._emit(C.SetG5xOffset(self.coord_index,
+                                          _pose(self._g5x()), line))
+                if ref:
+                    self._emit(C.SetG92Offset(_pose(self.g92), line))
+                    self._trace("SET_XY_ROTATION(0.0000)")
         if 13 in gs:
             self._control(block, gs[13])
         if 3 in gs:
+            if gs[3] != self.modal.distance:
+                self._trace('COMMENT("interpreter: distance mode changed to '
+                            f'{"absolute" if gs[3] == 900 else "incremental"}'
+                            '")')
             self.modal.distance = gs[3]
         if 4 in gs:
+            if gs[4] != self.modal.arc_distance:
+                self._trace('COMMENT("interpreter: IJK distance mode changed '
+                            f'to {"absolute" if gs[4] == 901 else "incremental"}'
+                            '")')
             self.modal.arc_distance = gs[4]
         if 10 in gs:
             self.modal.retract = gs[10]
+        if 15 in gs:
+            if not ref:
+                raise block.error(f"G{gs[15] // 10} (lathe diameter/radius "
+                                  "mode) is not supported",
+                                  code_key("g", gs[15] / 10))
+            diameter = gs[15] == 70
+            if diameter != self.diameter_mode:
+                self._trace('COMMENT("interpreter: Lathe diameter mode '
+                            f'changed to {"diameter" if diameter else "radius"}'
+                            '")')
+            self.diameter_mode = diameter
         g0 = gs.get(0)
         if g0 in (100,):
             self._g10(block)
@@ -234,6 +346,53 @@ class Interpreter:
         self._motion(block, gs)
         if 4 in ms:
             self._stop(ms[4], line)
+
+    def _feed_mode(self, block: Block, code: int) -> None:
+        if code == 950 and not self.ref:
+            raise block.error("G95 (feed per revolution) is not supported",
+                              "g95")
+        self.modal.feed_mode = code
+        if not self.ref:
+            self._emit(C.SetFeedMode(
+                "inverse_time" if code == 930 else "units_per_minute",
+                block.line))
+            return
+        what = {930: "inverse time", 940: "units per minute",
+                950: "units per revolution"}[code]
+        self._trace(f'COMMENT("interpreter: feed mode set to {what}")')
+        self._trace(f"SET_FEED_MODE(0, {1 if code == 950 else 0})")
+        if code != 930:
+            self._trace("SET_FEED_RATE(0.0000)")
+            self.feed = 0.0
+
+    def _orient(self, block: Block) -> None:
+        if not self.ref:
+            raise block.error("M19 (spindle orientation) is not supported",
+                              "m19")
+        r = block.words.get("r", 0.0)
+        q = int(block.words.get("q", 0))
+        self._trace(f"ORIENT_SPINDLE(0, {r:.4f}, {q})")
+
+    def _overrides(self, block: Block, code: int) -> None:
+        key = code_key("m", code / 10)
+        if not self.ref:
+            raise block.error(f"M{code // 10} (override control) is not "
+                              "supported", key)
+        on = block.words.get("p", 1.0) != 0
+        if code == 480:
+            self._trace("ENABLE_FEED_OVERRIDE()")
+            self._trace("ENABLE_SPEED_OVERRIDE(0)")
+        elif code == 490:
+            self._trace("DISABLE_FEED_OVERRIDE()")
+            self._trace("DISABLE_SPEED_OVERRIDE(0)")
+        elif code == 500:
+            self._trace(f"{'EN' if on else 'DIS'}ABLE_FEED_OVERRIDE()")
+        elif code == 510:
+            self._trace(f"{'EN' if on else 'DIS'}ABLE_SPEED_OVERRIDE(0)")
+        elif code == 520:
+            self._trace(f"{'EN' if on else 'DIS'}ABLE_ADAPTIVE_FEED()")
+        else:
+            self._trace(f"{'EN' if on else 'DIS'}ABLE_FEED_HOLD()")
 
     def pos_without_tlo(self) -> list[float]:
         return [self.pos[i] - self.tlo[i] for i in range(9)]
@@ -305,6 +464,10 @@ class Interpreter:
             allowed |= set("pelq")
         if ms.get(6) == 610:
             allowed.add("q")
+        if ms.get(7) == 190:
+            allowed |= set("rqp")
+        if 9 in ms:
+            allowed.add("p")
         return allowed
 
     # -- tools -----------------------------------------------------------
@@ -356,6 +519,10 @@ class Interpreter:
                 raise block.error("M6 without a tool selected by a T word",
                                   "m6")
             tool, pocket = self.selected_tool, self.selected_pocket
+            if self.ref:
+                self._trace("START_CHANGE()")
+                self._trace("STOP_SPINDLE_TURNING(0)")
+                self.modal.spindle = 50
             self._emit(C.ChangeTool(tool, pocket, block.line))
             if self.random:
                 if pocket != 0:
@@ -382,6 +549,8 @@ class Interpreter:
 
     def _cutter_comp(self, block: Block, code: int) -> None:
         key = code_key("g", code / 10)
+        self._trace('COMMENT("interpreter: cutter radius compensation '
+                    f'{ {400: "off", 410: "on left", 420: "on right"}[code] }")')
         if code == 400:
             self.comp.stop()
         else:
@@ -528,6 +697,11 @@ class Interpreter:
             self._emit(C.ProgramPause(line))
         elif code == 10:
             self._emit(C.OptionalPause(line))
+        elif code == 600:
+            self._trace("PALLET_SHUTTLE()")
+            self._emit(C.ProgramPause(line))
+        elif self.ref:
+            self._reference_end(code, line)
         else:
             m = self.modal
             if m.coord_system != 540:
@@ -545,15 +719,44 @@ class Interpreter:
             self._emit(C.ProgramEnd(code == 300, line))
             self.ended = True
 
+    def _reference_end(self, code: int, line: int) -> None:
+        """M2/M30 with the reference's calls (see :meth:`_stop`)."""
+        m = self.modal
+        m.coord_system = 540
+        self.params.set(5220, 1)
+        self._emit(C.SetG5xOffset(1, _pose(self._g5x()), line))
+        self._trace("SET_XY_ROTATION(0.0000)")
+        self.comp.stop()
+        if m.plane != 170:
+            self._emit(C.SetPlane(17, line))
+        m.plane, m.distance, m.feed_mode = 170, 900, 940
+        m.cutter_comp, m.motion = 400, 10
+        self._trace("SET_FEED_MODE(0, 0)")
+        self._trace("SET_FEED_RATE(0.0000)")
+        self.feed = 0.0
+        m.spindle = 50
+        self._emit(C.SpindleOff(line))
+        self._trace("SET_SPINDLE_MODE(0 0.0000)")
+        if m.mist:
+            self._trace("MIST_OFF()")
+        if m.flood:
+            self._trace("FLOOD_OFF()")
+        m.mist = m.flood = False
+        if code == 300:
+            self._trace("PALLET_SHUTTLE()")
+        self._emit(C.ProgramEnd(code == 300, line))
+        self.ended = True
+
     def _control(self, block: Block, code: int) -> None:
         if code == 640:
             p = block.words.get("p")
             q = block.words.get("q")
             if q is not None and p is None:
                 raise block.error("G64 Q needs a P word", "q")
-            self._emit(C.SetTermCond(
-                "blend", None if p is None else self._len(p),
-                None if q is None else self._len(q), block.line))
+            self.blend = (None if p is None else self._len(p),
+                          None if q is None else self._len(q))
+            self._emit(C.SetTermCond("blend", self.blend[0], self.blend[1],
+                                     block.line))
         else:
             self._emit(C.SetTermCond(
                 "exact_path" if code == 610 else "exact_stop",
@@ -586,6 +789,10 @@ class Interpreter:
                 self.params.set(base + i, value)
         if index == self.coord_index:
             self._emit(C.SetG5xOffset(index, _pose(self._g5x()), block.line))
+            self._trace("SET_XY_ROTATION(0.0000)")
+        else:
+            self._trace('COMMENT("interpreter: setting coordinate system '
+                        'origin")')
 
     def _g92(self, block: Block, code: int) -> None:
         if code == 920:
@@ -611,10 +818,10 @@ class Interpreter:
         base = 5161 if code == 280 else 5181
         home = [self.params.get(base + i) + self.tlo[i] for i in range(9)]
         axes = self._axis_words(block)
-        if axes:
+        if axes or self.ref:
             middle = self._target(block)
             self._traverse(middle, line)
-            end = list(self.pos)
+            end = list(self.pos) if axes else list(home)
             for i, a in enumerate(AXES):
                 if a in block.words:
                     end[i] = home[i]
@@ -655,6 +862,8 @@ class Interpreter:
             self.modal.motion = explicit
             if explicit == 800:
                 self.cycle = {}
+                self._trace('COMMENT("interpreter: motion mode set to '
+                            'none")')
         has_axes = bool(self._axis_words(block))
         if gs.get(0) in AXIS_USERS_GROUP0 or gs.get(8) == 431:
             return
@@ -845,9 +1054,10 @@ class Interpreter:
         if self.feed <= 0 or self.modal.feed_mode == 930:
             raise block.error("canned cycle needs a feed rate in G94 mode",
                               key)
-        if old < r:
-            prog[d] = r
+        if old < r or self.ref:
+            prog[d] = max(old, r)
             self._traverse(self._to_machine(prog), line)
+        self._trace("SET_MOTION_CONTROL_MODE(CANON_EXACT_PATH)")
         for _ in range(repeats):
             for axis in (a1, a2):
                 letter = AXES[axis]
@@ -855,11 +1065,17 @@ class Interpreter:
                     value = block.words[letter] * self._k(axis)
                     prog[axis] = prog[axis] + value if incremental else value
             self._traverse(self._to_machine(prog), line)
-            prog[d] = r
-            self._traverse(self._to_machine(prog), line)
+            if not (self.ref and prog[d] == r):
+                prog[d] = r
+                self._traverse(self._to_machine(prog), line)
             self._cycle_body(motion, prog, d, r, bottom, line)
             prog[d] = clear
             self._traverse(self._to_machine(prog), line)
+        if self.ref:
+            self._emit(C.SetTermCond(
+                {610: "exact_path", 611: "exact_stop"}.get(
+                    self.modal.control, "blend"),
+                self.blend[0], self.blend[1], line))
 
     def _cycle_body(self, motion: int, prog: list[float], d: int, r: float,
                     bottom: float, line: int) -> None:
