@@ -100,6 +100,8 @@ class Interpreter:
         self.random = random_toolchanger
         self.machine_metric = units == "mm"
         self.modal = ModalState(units=210 if program_units == "mm" else 200)
+        if self.ref:
+            self.modal.retract = 990    # the reference starts in G99
         self.pos = [0.0] * 9
         self.tlo = [0.0] * 9
         self.g92 = [0.0] * 9
@@ -117,6 +119,8 @@ class Interpreter:
         self.selected_tool = -1
         self.selected_pocket = -1
         self.diameter_mode = False
+        self._previous_motion = 10
+        self.cycle_il: Optional[float] = None
         self.blend: tuple[Optional[float], Optional[float]] = (None, None)
         self.cycle: dict[str, float] = {}
         self.line = 0
@@ -239,8 +243,8 @@ class Interpreter:
             if f < 0:
                 raise block.error("negative feed rate", "f")
             if ref:
-                self._trace(f"SET_FEED_RATE({f:.4f})")
                 if self.modal.feed_mode != 930:
+                    self._trace(f"SET_FEED_RATE({f:.4f})")
                     self.feed = self._len(f)
             elif self.modal.feed_mode == 940:
                 self.feed = self._len(f)
@@ -317,6 +321,8 @@ class Interpreter:
             self.modal.arc_distance = gs[4]
         if 10 in gs:
             self.modal.retract = gs[10]
+            self._trace('COMMENT("interpreter: retract mode set to '
+                        f'{"old_z" if gs[10] == 980 else "r_plane"}")')
         if 15 in gs:
             if not ref:
                 raise block.error(f"G{gs[15] // 10} (lathe diameter/radius "
@@ -753,6 +759,8 @@ class Interpreter:
             q = block.words.get("q")
             if q is not None and p is None:
                 raise block.error("G64 Q needs a P word", "q")
+            if q is None and p is not None and self.ref:
+                q = p
             self.blend = (None if p is None else self._len(p),
                           None if q is None else self._len(q))
             self._emit(C.SetTermCond("blend", self.blend[0], self.blend[1],
@@ -847,14 +855,23 @@ class Interpreter:
             raise block.error("feed move with zero feed rate", "")
         return self.feed
 
+    def _inverse_time_trace(self, length: float) -> None:
+        """G93: the reference sets the feed rate of each move."""
+        block = self.line_block
+        if self.ref and self.modal.feed_mode == 930 and block is not None:
+            rate = length / self._k() * block.words.get("f", 0.0)
+            self._trace(f"SET_FEED_RATE({rate:.4f})")
+
     def _straight_feed(self, block: Block, end: list[float]) -> None:
         length = math.dist(self.pos, end)
         feed = self._feed_for(block, length)
+        self._inverse_time_trace(length)
         self._emit(C.StraightFeed(_pose(end), feed, block.line))
         self.pos = list(end)
 
     def _motion(self, block: Block, gs: dict[int, int]) -> None:
         explicit = gs.get(1)
+        self._previous_motion = self.modal.motion
         if explicit is not None:
             if explicit in UNSUPPORTED_MOTION:
                 raise block.error(f"{UNSUPPORTED_MOTION[explicit]} is not "
@@ -892,9 +909,11 @@ class Interpreter:
             raise block.error("G53 in incremental mode (G91)", "g53")
         if motion in (0, 10, 330) or 382 <= motion <= 385:
             if not has_axes:
-                if motion in (0, 10):
+                # the reference moves to where it is on a G0/G1 alone
+                if motion in (0, 10) and not (self.ref and explicit is not None):
                     return
-                raise block.error(f"G{motion / 10:g} needs an axis word", key)
+                if motion not in (0, 10):
+                    raise block.error(f"G{motion / 10:g} needs an axis word", key)
             end = self._target(block, g53)
             if motion == 0:
                 self._traverse(end, line)
@@ -994,6 +1013,7 @@ class Interpreter:
         turn = turns if motion == 30 else -turns
         length = self._arc_length(start, end, (c1, c2), a1, a2, turn)
         feed = self._feed_for(block, length)
+        self._inverse_time_trace(length)
         self._emit(C.ArcFeed(_pose(end), (c1, c2), self.modal.plane // 10,
                              turn, feed, block.line))
         self.pos = list(end)
@@ -1044,6 +1064,11 @@ class Interpreter:
         k = self._k()
         prog = self.program_position()
         old = prog[d]
+        if self.ref:
+            # the reference keeps the level where the cycle started
+            if self._previous_motion != motion or self.cycle_il is None:
+                self.cycle_il = old
+            old = self.cycle_il
         incremental = self.modal.distance == 910
         r = self.cycle["r"] * k + (old if incremental else 0.0)
         bottom = self.cycle[dl] * k + (r if incremental else 0.0)
@@ -1054,8 +1079,8 @@ class Interpreter:
         if self.feed <= 0 or self.modal.feed_mode == 930:
             raise block.error("canned cycle needs a feed rate in G94 mode",
                               key)
-        if old < r or self.ref:
-            prog[d] = max(old, r)
+        if old < r:
+            prog[d] = r
             self._traverse(self._to_machine(prog), line)
         self._trace("SET_MOTION_CONTROL_MODE(CANON_EXACT_PATH)")
         for _ in range(repeats):
