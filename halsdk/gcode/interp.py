@@ -102,6 +102,7 @@ class Interpreter:
         self.modal = ModalState(units=210 if program_units == "mm" else 200)
         if self.ref:
             self.modal.retract = 990    # the reference starts in G99
+            self.modal.motion = 800     # and in G80
         self.pos = [0.0] * 9
         self.tlo = [0.0] * 9
         self.g92 = [0.0] * 9
@@ -178,6 +179,8 @@ class Interpreter:
         for i, a in enumerate(AXES):
             if a in block.words:
                 value = block.words[a] * self._k(i)
+                if i == 0 and self.diameter_mode:
+                    value /= 2      # G7: X words are diameters
                 prog[i] = prog[i] + value if incremental else value
         return self._to_machine(prog)
 
@@ -375,9 +378,13 @@ class Interpreter:
         if not self.ref:
             raise block.error("M19 (spindle orientation) is not supported",
                               "m19")
-        r = block.words.get("r", 0.0)
-        q = int(block.words.get("q", 0))
-        self._trace(f"ORIENT_SPINDLE(0, {r:.4f}, {q})")
+        words = block.words
+        if not ("r" in words or "q" in words or "p" in words):
+            return
+        r = words.get("r", 0.0)
+        self._trace(f"ORIENT_SPINDLE(0, {r:.4f}, {int(words.get('p', 0))})")
+        if "q" in words:
+            self._trace(f"SPINDLE.0.WAIT_ORIENT_COMPLETE({words['q']:.4f})")
 
     def _overrides(self, block: Block, code: int) -> None:
         key = code_key("m", code / 10)
@@ -521,6 +528,8 @@ class Interpreter:
 
     def _tool_change(self, block: Block, code: int) -> None:
         if code == 60:
+            if self.selected_tool < 0 and self.ref:
+                self.selected_tool = self.selected_pocket = 0
             if self.selected_tool < 0:
                 raise block.error("M6 without a tool selected by a T word",
                                   "m6")
@@ -1082,7 +1091,9 @@ class Interpreter:
         if old < r:
             prog[d] = r
             self._traverse(self._to_machine(prog), line)
-        self._trace("SET_MOTION_CONTROL_MODE(CANON_EXACT_PATH)")
+        wrap = self.modal.control != 610
+        if wrap:
+            self._trace("SET_MOTION_CONTROL_MODE(CANON_EXACT_PATH)")
         for _ in range(repeats):
             for axis in (a1, a2):
                 letter = AXES[axis]
@@ -1096,7 +1107,7 @@ class Interpreter:
             self._cycle_body(motion, prog, d, r, bottom, line)
             prog[d] = clear
             self._traverse(self._to_machine(prog), line)
-        if self.ref:
+        if self.ref and wrap:
             self._emit(C.SetTermCond(
                 {610: "exact_path", 611: "exact_stop"}.get(
                     self.modal.control, "blend"),

@@ -143,7 +143,11 @@ def run(text: str, file: str, write: Callable[[str], Any],
         program = Program(text, file, params, search_path,
                           block_delete=block_delete)
         interp.run(program)
-        if not interp.ended and _finished_with_percent(text):
+        if not interp.ended:
+            if not _finished_with_percent(text):
+                lines = text.splitlines()
+                raise GCodeError("file ended with no percent sign or "
+                                 "program end", file, len(lines))
             canon.call("FINISH()")
     except GCodeError as exc:
         error(f"{exc}\n")

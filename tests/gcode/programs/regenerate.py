@@ -48,7 +48,6 @@ def programs() -> list[Path]:
 
 
 def run_one(prog: Path, reference: str) -> int:
-    name = prog.stem
     with tempfile.TemporaryDirectory(prefix="rs274-golden-") as tmp:
         os.chmod(tmp, 0o755)
         work = Path(tmp)
