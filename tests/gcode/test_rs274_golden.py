@@ -22,6 +22,8 @@ import sys
 from pathlib import Path
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from halsdk.gcode.rs274 import run
 
@@ -127,5 +129,31 @@ def test_console_script(tmp_path: Path) -> None:
     done = subprocess.run(
         [sys.executable, "-m", "halsdk.gcode.rs274", "--help"],
         capture_output=True, text=True, timeout=120, cwd=tmp_path, env=env)
-    assert done.returncode == 0 and "-t tool.tbl" in done.stdout.replace(
-        "-t tool.tbl", "-t tool.tbl")
+    assert done.returncode == 0
+    assert "-t tool.tbl" in done.stdout and "-v file.var" in done.stdout
+
+
+coordinate = st.decimals(min_value=-9999, max_value=9999, places=4,
+                         allow_nan=False, allow_infinity=False)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.tuples(coordinate, coordinate, coordinate),
+                min_size=1, max_size=4),
+       st.sampled_from(["G20", "G21"]), coordinate)
+def test_positions_print_as_programmed(moves: list, units: str,
+                                       offset: object) -> None:
+    """Whatever the units and the work offset, a G0 prints the program
+    coordinates as written (the machine-unit round trip of our
+    interpreter never shows in the 4 decimals)."""
+    lines = [units, f"G10 L2 P1 X{offset} Y{offset}"]
+    lines += [f"G0 X{x} Y{y} Z{z}" for x, y, z in moves]
+    out = io.StringIO()
+    status = run("\n".join(lines + ["M2"]) + "\n", "p.ngc", out.write,
+                 io.StringIO().write)
+    assert status == 0
+    got = [ln[ln.index("STRAIGHT"):] for ln in out.getvalue().splitlines()
+           if "STRAIGHT_TRAVERSE" in ln]
+    want = [f"STRAIGHT_TRAVERSE({float(x):.4f}, {float(y):.4f}, "
+            f"{float(z):.4f}, 0.0000, 0.0000, 0.0000)" for x, y, z in moves]
+    assert [normalise(g) for g in got] == [normalise(w) for w in want]
