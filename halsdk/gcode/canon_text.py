@@ -67,9 +67,8 @@ class TextCanon(C.Canon):
     def _prog(self, pose: Any) -> list[float]:
         """Machine ``pose`` -> program coordinates in program units."""
         it = self.interp
-        g5x = it._g5x()
-        return [(pose[i] - g5x[i] - it.g92[i] - it.tlo[i]) / self._k(i)
-                for i in range(9)]
+        d = it._unrotated(list(pose))
+        return [(d[i] - it.g92[i]) / self._k(i) for i in range(9)]
 
     def _units(self, values: Any) -> list[float]:
         """Machine-unit lengths (offsets) -> program units."""
@@ -86,7 +85,7 @@ class TextCanon(C.Canon):
         self.call(f"SET_G5X_OFFSET({it.coord_index}, "
                   f"{self._six(self._units(it._g5x()))})")
         self.call(f"SET_G92_OFFSET({self._six(self._units(it.g92))})")
-        self.call("SET_XY_ROTATION(0.0000)")
+        self.call(f"SET_XY_ROTATION({it.rotation:.4f})")
         self.call("SET_FEED_REFERENCE(CANON_XYZ)")
         self.call("ON_RESET()")
 

@@ -21,7 +21,8 @@ Conventions
   it needs the spindle on clockwise (M3).  G88 feeds in, dwells, stops the
   spindle and pauses the program so the operator can withdraw the tool by
   hand, then restarts the spindle; it needs the spindle on.
-* Not supported (clear error): G76, G87, G10 L2/L20 rotation (R).
+* G10 L2/L20 R rotates the coordinate system in XY about its origin.
+* Not supported (clear error): G76, G87.
 """
 
 from __future__ import annotations
@@ -74,6 +75,13 @@ PLANES = {170: (0, 1, 2, "ij"), 180: (2, 0, 1, "ki"), 190: (1, 2, 0, "jk")}
 COORD_CODES = (540, 550, 560, 570, 580, 590, 591, 592, 593)
 CANNED = (730, 810, 820, 830, 840, 850, 860, 880, 890)
 UNSUPPORTED_MOTION = {760: "G76", 870: "G87"}
+
+
+def _rotate(x: float, y: float, degrees: float) -> tuple[float, float]:
+    """(x, y) turned counter-clockwise by ``degrees``."""
+    t = math.radians(degrees)
+    c, s = math.cos(t), math.sin(t)
+    return x * c - y * s, x * s + y * c
 
 
 def _pose(values: Any) -> C.Pose:
@@ -152,16 +160,37 @@ class Interpreter:
         base = 5201 + 20 * (index or self.coord_index)
         return [self.params.get(base + i) for i in range(9)]
 
-    def program_position(self) -> list[float]:
-        """Current position in program coordinates, machine units."""
+    @property
+    def rotation(self) -> float:
+        """The XY rotation of the active coordinate system (degrees,
+        G10 L2 R): its parameter follows the nine offsets."""
+        return float(self.params.get(5210 + 20 * self.coord_index))
+
+    def _unrotated(self, machine: list[float]) -> list[float]:
+        """``machine`` less the G5x offset and the TLO, turned back by the
+        rotation: G92-shifted program coordinates."""
         g5x = self._g5x()
-        return [self.pos[i] - g5x[i] - self.g92[i] - self.tlo[i]
-                for i in range(9)]
+        d = [machine[i] - g5x[i] - self.tlo[i] for i in range(9)]
+        angle = self.rotation
+        if angle:
+            d[0], d[1] = _rotate(d[0], d[1], -angle)
+        return d
+
+    def program_position(self) -> list[float]:
+        """Current position in program coordinates, machine units.
+
+        program = rotate(machine - G5x - TLO, -R) - G92: the reference's
+        order (the rotation turns about the G5x origin)."""
+        d = self._unrotated(self.pos)
+        return [d[i] - self.g92[i] for i in range(9)]
 
     def _to_machine(self, prog: list[float]) -> list[float]:
         g5x = self._g5x()
-        return [prog[i] + g5x[i] + self.g92[i] + self.tlo[i]
-                for i in range(9)]
+        v = [prog[i] + self.g92[i] for i in range(9)]
+        angle = self.rotation
+        if angle:
+            v[0], v[1] = _rotate(v[0], v[1], angle)
+        return [v[i] + g5x[i] + self.tlo[i] for i in range(9)]
 
     def _axis_words(self, block: Block) -> list[str]:
         return [a for a in AXES if a in block.words]
@@ -307,7 +336,7 @@ class Interpreter:
                                           _pose(self._g5x()), line))
                 if ref:
                     self._emit(C.SetG92Offset(_pose(self.g92), line))
-                    self._trace("SET_XY_ROTATION(0.0000)")
+                    self._trace(f"SET_XY_ROTATION({self.rotation:.4f})")
         if 13 in gs:
             self._control(block, gs[13])
         if 3 in gs:
@@ -740,7 +769,7 @@ class Interpreter:
         m.coord_system = 540
         self.params.set(5220, 1)
         self._emit(C.SetG5xOffset(1, _pose(self._g5x()), line))
-        self._trace("SET_XY_ROTATION(0.0000)")
+        self._trace(f"SET_XY_ROTATION({self.rotation:.4f})")
         self.comp.stop()
         if m.plane != 170:
             self._emit(C.SetPlane(17, line))
@@ -790,23 +819,33 @@ class Interpreter:
             return
         if level not in (2, 20):
             raise block.error(f"G10 L{level:g} is not supported", "l")
-        if block.words.get("r", 0.0):
-            raise block.error("coordinate system rotation (G10 R) is not "
-                              "supported", "r")
         p = self._index(block, "p", "G10 L2/L20")
         if p > 9:
             raise block.error(f"G10 P{p}: coordinate systems are 0..9", "p")
         index = p or self.coord_index
         base = 5201 + 20 * index
+        angle = float(self.params.get(base + 9))
+        if level == 20:
+            # the origin that makes the current point read the words
+            target = [self.pos[i] - self.tlo[i] for i in range(9)]
+            want = self.program_position()
+            for i, a in enumerate(AXES):
+                if a in block.words:
+                    want[i] = block.words[a] * self._k(i)
+            v = [want[i] + self.g92[i] for i in range(9)]
+            if angle:
+                v[0], v[1] = _rotate(v[0], v[1], angle)
         for i, a in enumerate(AXES):
             if a in block.words:
                 value = block.words[a] * self._k(i)
                 if level == 20:
-                    value = self.pos[i] - self.tlo[i] - self.g92[i] - value
+                    value = target[i] - v[i]
                 self.params.set(base + i, value)
+        if "r" in block.words:
+            self.params.set(base + 9, block.words["r"])
         if index == self.coord_index:
             self._emit(C.SetG5xOffset(index, _pose(self._g5x()), block.line))
-            self._trace("SET_XY_ROTATION(0.0000)")
+            self._trace(f"SET_XY_ROTATION({self.rotation:.4f})")
         else:
             self._trace('COMMENT("interpreter: setting coordinate system '
                         'origin")')
@@ -815,11 +854,10 @@ class Interpreter:
         if code == 920:
             if not self._axis_words(block):
                 raise block.error("G92 needs at least one axis word", "g92")
-            g5x = self._g5x()
+            here = self._unrotated(self.pos)
             for i, a in enumerate(AXES):
                 if a in block.words:
-                    self.g92[i] = (self.pos[i] - self.tlo[i] - g5x[i]
-                                   - block.words[a] * self._k(i))
+                    self.g92[i] = here[i] - block.words[a] * self._k(i)
         elif code in (921, 922):
             self.g92 = [0.0] * 9
         else:
@@ -957,6 +995,9 @@ class Interpreter:
     def _arc(self, block: Block, motion: int) -> None:
         key = code_key("g", motion / 10)
         a1, a2, _normal, centre_words = PLANES[self.modal.plane]
+        if self.rotation and self.modal.plane != 170:
+            raise block.error("arcs outside G17 in a rotated coordinate "
+                              "system (G10 L2 R) are not supported", key)
         names = AXES[a1].upper() + AXES[a2].upper()
         in_plane = AXES[a1] in block.words or AXES[a2] in block.words
         start = self.pos
@@ -997,12 +1038,13 @@ class Interpreter:
                     raise block.error(
                         f"absolute arc centres (G90.1) need both "
                         f"{w1.upper()} and {w2.upper()}", key)
-                g5x = self._g5x()
-                c1 = (o1 + g5x[a1] + self.g92[a1] + self.tlo[a1]
-                      if w1 in block.words else s1)
-                c2 = (o2 + g5x[a2] + self.g92[a2] + self.tlo[a2]
-                      if w2 in block.words else s2)
+                point = self.program_position()
+                point[a1], point[a2] = o1, o2
+                centre = self._to_machine(point)
+                c1, c2 = centre[a1], centre[a2]
             else:
+                if self.rotation and self.modal.plane == 170:
+                    o1, o2 = _rotate(o1, o2, self.rotation)
                 c1, c2 = s1 + o1, s2 + o2
             r1 = math.hypot(s1 - c1, s2 - c2)
             r2 = math.hypot(e1 - c1, e2 - c2)

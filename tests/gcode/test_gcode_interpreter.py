@@ -223,7 +223,27 @@ def test_g10_l20_and_g92_family():
     assert interp.g92[0] == 5
     interp.execute(next(iter(Program("G92.1\n").blocks())))
     assert interp.g92[0] == 0 and p.get(5211) == 0 and p.get(5210) == 0
-    assert "not supported" in str(err("G10 L2 P1 R30\n"))
+
+
+def test_g10_l2_rotation_turns_about_the_g5x_origin():
+    # G10 L2 R: program X1 Y0 in a system at (5, 5) turned 90 degrees
+    interp, rec = run("G10 L2 P1 X5 Y5 R90\nG0 X1 Y0\n")
+    end = moves(rec)[-1].end
+    assert end[0] == pytest.approx(5) and end[1] == pytest.approx(6)
+    assert interp.params.get(5230) == 90
+    assert interp.program_position()[0] == pytest.approx(1)
+    # an incremental centre turns with the system: a half circle from
+    # program (0, 0) to (2, 0) about (1, 0) has its machine centre at (5, 6)
+    interp, rec = run("G10 L2 P1 X5 Y5 R90\nG0 X0 Y0\n"
+                      "G2 X2 Y0 I1 J0 F100\n")
+    arc = rec.of_type(C.ArcFeed)[-1]
+    assert arc.center == pytest.approx((5, 6))
+    assert arc.end[:2] == pytest.approx((5, 7))
+    # G92 in a rotated system: the current point reads the given value
+    interp, _ = run("G10 L2 P1 R30\nG0 X3 Y4\nG92 X0 Y0\n")
+    assert interp.program_position()[:2] == pytest.approx([0, 0])
+    assert "not supported" in str(err("G10 L2 P1 R30\nG18\n"
+                                      "G2 X1 Z1 R1 F10\n"))
 
 
 def test_g92_persisted_in_parameters_restored_at_start():
