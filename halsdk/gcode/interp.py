@@ -120,6 +120,8 @@ class Interpreter:
         self.modal.coord_system = COORD_CODES[min(max(index, 1), 9) - 1]
         self.params.set(5220, index)
         self.feed = 0.0
+        #: the last F number as written (the feed in program units)
+        self.feed_value = 0.0
         self.speed = 0.0
         self.current_tool = -1 if self.random else 0
         spindle = getattr(tools, "spindle", None)
@@ -129,6 +131,11 @@ class Interpreter:
         self.selected_pocket = -1
         self.diameter_mode = False
         self._previous_motion = 10
+        #: the program being run (for M73: its call level)
+        self.program: Any = None
+        #: M70 state and the M73 state with its call level
+        self._saved: Optional[dict[str, Any]] = None
+        self._autosaved: list[tuple[int, dict[str, Any]]] = []
         self.cycle_il: Optional[float] = None
         self.blend: tuple[Optional[float], Optional[float]] = (None, None)
         self.cycle: dict[str, float] = {}
@@ -250,6 +257,7 @@ class Interpreter:
     # -- public API ------------------------------------------------------
     def run(self, program: Any) -> None:
         """Execute every block of ``program`` until it ends."""
+        self.program = program
         for block in program.blocks():
             self.execute(block)
             if self.ended:
@@ -264,6 +272,7 @@ class Interpreter:
         self._check(block, gs, ms)
         line = block.line
         ref = self.ref
+        self._auto_restore(block)
         if ref:
             self._comment_trace(block)
         elif block.message:
@@ -274,6 +283,7 @@ class Interpreter:
             f = block.words["f"]
             if f < 0:
                 raise block.error("negative feed rate", "f")
+            self.feed_value = f
             if ref:
                 if self.modal.feed_mode != 930:
                     self._trace(f"SET_FEED_RATE({f:.4f})")
@@ -301,6 +311,8 @@ class Interpreter:
                 self._orient(block)
             else:
                 self._spindle(ms[7], line)
+        if 10 in ms:
+            self._modal_state(block, ms[10])
         if 8 in ms:
             code = ms[8]
             self.modal.mist = code == 70 or (self.modal.mist and code != 90)
@@ -385,15 +397,117 @@ class Interpreter:
         if 4 in ms:
             self._stop(ms[4], line)
 
+    # -- M70-M73: saving and restoring the modal state --------------------
+    def _state(self) -> dict[str, Any]:
+        m = self.modal
+        return {"units": m.units, "plane": m.plane, "distance": m.distance,
+                "arc_distance": m.arc_distance, "feed_mode": m.feed_mode,
+                "feed": self.feed, "feed_value": self.feed_value,
+                "speed": self.speed,
+                "spindle": m.spindle, "mist": m.mist, "flood": m.flood,
+                "coord_system": m.coord_system, "control": m.control,
+                "blend": self.blend, "retract": m.retract,
+                "diameter": self.diameter_mode}
+
+    def _modal_state(self, block: Block, code: int) -> None:
+        if code == 700:
+            self._saved = self._state()
+        elif code == 710:
+            self._saved = None
+        elif code == 720:
+            if self._saved is None:
+                raise block.error("M72 without a state saved by M70",
+                                  "m72")
+            self._restore(self._saved, block.line)
+        else:
+            # in the main program (level 0) it is never restored
+            level = getattr(self.program, "call_level", 0)
+            self._autosaved.append((level, self._state()))
+
+    def _auto_restore(self, block: Block) -> None:
+        """M73: the state comes back when its subroutine has returned."""
+        level = getattr(self.program, "call_level", 0)
+        while self._autosaved and self._autosaved[-1][0] > level:
+            _, state = self._autosaved.pop()
+            self._restore(state, block.line)
+
+    def _restore(self, state: dict[str, Any], line: int) -> None:
+        """Bring back a saved modal state, in the reference's order, with
+        a call for each setting that changed."""
+        m = self.modal
+        if state["units"] != m.units:
+            m.units = state["units"]
+            self._trace("USE_LENGTH_UNITS(CANON_UNITS_"
+                        f"{'MM' if m.units == 210 else 'INCHES'})")
+        if state["feed_mode"] != m.feed_mode:
+            self._feed_mode_calls(state["feed_mode"], line)
+        elif state["feed"] != self.feed:
+            if self.ref:
+                self._trace(f"SET_FEED_RATE({state['feed_value']:.4f})")
+            else:
+                self._emit(C.SetFeedRate(state["feed"], line))
+        self.feed, self.feed_value = state["feed"], state["feed_value"]
+        if state["speed"] != self.speed:
+            self.speed = state["speed"]
+            if self.ref:
+                self._trace(f"SET_SPINDLE_SPEED(0, {self.speed:.4f})")
+            else:
+                self._emit(C.SpindleSpeed(self.speed, line))
+        if state["spindle"] != m.spindle:
+            self._spindle(state["spindle"], line)
+        # coolant as one M code (flood counts before mist), as the
+        # reference compares it
+        def coolant(mist: bool, flood: bool) -> str:
+            return "flood" if flood else "mist" if mist else "off"
+        saved = coolant(state["mist"], state["flood"])
+        if saved != coolant(m.mist, m.flood):
+            self._emit(C.Coolant(saved, line))
+            m.mist, m.flood = saved == "mist", saved == "flood"
+        if state["plane"] != m.plane:
+            m.plane = state["plane"]
+            self._emit(C.SetPlane(m.plane // 10, line))
+        if state["coord_system"] != m.coord_system:
+            m.coord_system = state["coord_system"]
+            self.params.set(5220, self.coord_index)
+            self._emit(C.SetG5xOffset(self.coord_index, _pose(self._g5x()),
+                                      line))
+            if self.ref:
+                self._emit(C.SetG92Offset(_pose(self.g92), line))
+                self._trace(f"SET_XY_ROTATION({self.rotation:.4f})")
+        if (state["control"], state["blend"]) != (m.control, self.blend):
+            m.control, self.blend = state["control"], state["blend"]
+            mode = {610: "exact_path", 611: "exact_stop"}.get(m.control,
+                                                              "blend")
+            self._emit(C.SetTermCond(mode, self.blend[0], self.blend[1],
+                                     line))
+        if state["distance"] != m.distance:
+            m.distance = state["distance"]
+            self._trace('COMMENT("interpreter: distance mode changed to '
+                        f'{"absolute" if m.distance == 900 else "incremental"}'
+                        '")')
+        if state["retract"] != m.retract:
+            m.retract = state["retract"]
+            self._trace('COMMENT("interpreter: retract mode set to '
+                        f'{"old_z" if m.retract == 980 else "r_plane"}")')
+        if state["arc_distance"] != m.arc_distance:
+            m.arc_distance = state["arc_distance"]
+            self._trace('COMMENT("interpreter: IJK distance mode changed to '
+                        f'{"absolute" if m.arc_distance == 901 else "incremental"}'
+                        '")')
+        self.diameter_mode = state["diameter"]
+
     def _feed_mode(self, block: Block, code: int) -> None:
         if code == 950 and not self.ref:
             raise block.error("G95 (feed per revolution) is not supported",
                               "g95")
+        self._feed_mode_calls(code, block.line)
+
+    def _feed_mode_calls(self, code: int, line: int) -> None:
         self.modal.feed_mode = code
         if not self.ref:
             self._emit(C.SetFeedMode(
                 "inverse_time" if code == 930 else "units_per_minute",
-                block.line))
+                line))
             return
         what = {930: "inverse time", 940: "units per minute",
                 950: "units per revolution"}[code]
@@ -401,7 +515,7 @@ class Interpreter:
         self._trace(f"SET_FEED_MODE(0, {1 if code == 950 else 0})")
         if code != 930:
             self._trace("SET_FEED_RATE(0.0000)")
-            self.feed = 0.0
+            self.feed = self.feed_value = 0.0
 
     def _orient(self, block: Block) -> None:
         if not self.ref:
@@ -777,7 +891,7 @@ class Interpreter:
         m.cutter_comp, m.motion = 400, 10
         self._trace("SET_FEED_MODE(0, 0)")
         self._trace("SET_FEED_RATE(0.0000)")
-        self.feed = 0.0
+        self.feed = self.feed_value = 0.0
         m.spindle = 50
         self._emit(C.SpindleOff(line))
         self._trace("SET_SPINDLE_MODE(0 0.0000)")

@@ -41,6 +41,7 @@ M_GROUPS: dict[int, tuple[int, ...]] = {
     7: (30, 40, 50, 190),
     8: (70, 80, 90),
     9: (480, 490, 500, 510, 520, 530),
+    10: (700, 710, 720, 730),
 }
 _G_OF = {code: group for group, codes in G_GROUPS.items() for code in codes}
 _M_OF = {code: group for group, codes in M_GROUPS.items() for code in codes}

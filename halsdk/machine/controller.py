@@ -467,6 +467,7 @@ class TaskController:
                           max_iterations=self.max_iterations,
                           max_idle_time=self.max_idle_time)
         self._running = program
+        self.interp.program = program     # M73: its call level
         self._start_job(job, program.blocks())
         self.last_command = line
 
@@ -541,6 +542,7 @@ class TaskController:
             raise MachineError(f"program run: {self.file}: {e.strerror}"
                                ) from None
         self._running = program
+        self.interp.program = program     # M73: its call level
         self._start_job(_Job(t, self.file), program.blocks(), start_line)
 
         def finished() -> bool:

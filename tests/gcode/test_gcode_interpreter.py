@@ -617,3 +617,17 @@ def test_probe_kinds_and_no_tool_table():
     with pytest.raises(GCodeError, match="tool 1 is not in the tool table"):
         interp.execute(Block("a.ngc", 3, "T1", words={"t": 1},
                              columns={"t": 1}))
+
+
+def test_m70_m72_and_m73_restore_the_modal_state():
+    interp, rec = run("G21 F100 M70\nG18 G20 G91 F2\nM72\nG1 X1\n")
+    assert interp.modal.plane == 170 and interp.modal.units == 210
+    assert interp.modal.distance == 900
+    assert rec.of_type(C.SetPlane)[-1].plane == 17
+    assert rec.of_type(C.SetFeedRate)[-1].feed == pytest.approx(100)
+    assert moves(rec)[-1].end[0] == pytest.approx(1)
+    # M73: the state of the caller comes back when the subroutine returns
+    interp, rec = run("o1 sub\nM73\nG20 G91\no1 endsub\no1 call\nG0 X1\n")
+    assert interp.modal.units == 210 and interp.modal.distance == 900
+    assert moves(rec)[-1].end[0] == pytest.approx(1)
+    assert "M72 without" in str(err("M70\nM71\nM72\n"))
