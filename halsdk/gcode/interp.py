@@ -1218,10 +1218,10 @@ class Interpreter:
         if motion in (730, 830) and self.cycle.get("q", 0) <= 0:
             raise block.error(f"G{motion / 10:g} needs a positive Q word",
                               key)
-        if motion == 840 and self.modal.spindle != 30:
+        if motion == 840 and self.modal.spindle != 30 and not self.ref:
             raise block.error("G84 needs the spindle turning clockwise (M3)",
                               key)
-        if motion == 880 and self.modal.spindle == 50:
+        if motion == 880 and self.modal.spindle == 50 and not self.ref:
             raise block.error("G88 needs the spindle turning", key)
         repeats = int(block.words.get("l", 1))
         if repeats < 0:
@@ -1250,6 +1250,10 @@ class Interpreter:
         wrap = self.modal.control != 610
         if wrap:
             self._trace("SET_MOTION_CONTROL_MODE(CANON_EXACT_PATH)")
+        if self.ref and motion in (820, 860, 880, 890) and \
+                "p" not in self.cycle:
+            raise block.error("dwell time P word missing with "
+                              f"G{motion // 10}", key)
         for _ in range(repeats):
             for axis in (a1, a2):
                 letter = AXES[axis]
@@ -1260,6 +1264,10 @@ class Interpreter:
             if not (self.ref and prog[d] == r):
                 prog[d] = r
                 self._traverse(self._to_machine(prog), line)
+            if self.ref and motion in (840, 860, 880, 890):
+                self._reference_cycle_body(motion, prog, d, bottom, clear,
+                                           line)
+                continue
             self._cycle_body(motion, prog, d, r, bottom, line)
             prog[d] = clear
             self._traverse(self._to_machine(prog), line)
@@ -1268,6 +1276,52 @@ class Interpreter:
                 {610: "exact_path", 611: "exact_stop"}.get(
                     self.modal.control, "blend"),
                 self.blend[0], self.blend[1], line))
+
+    def _reference_cycle_body(self, motion: int, prog: list[float], d: int,
+                              bottom: float, clear: float, line: int) -> None:
+        """G84, G86, G88 and G89 as the reference's rs274 runs them: they
+        end at the clear plane themselves (G88: where the operator
+        withdrew the tool), without the final rapid of the others."""
+        def feed(z: float) -> None:
+            prog[d] = z
+            end = self._to_machine(prog)
+            self._emit(C.StraightFeed(_pose(end), self.feed, line))
+            self.pos = end
+
+        dwell = self.cycle.get("p", 0.0)
+        direction = 1 if self.modal.spindle == 30 else -1
+        if motion == 840 and self.modal.spindle != 30:
+            block = self.line_block
+            assert block is not None
+            raise block.error("G84 needs the spindle turning clockwise (M3)",
+                              code_key("g", 84))
+        if motion == 840:
+            self._trace("DISABLE_FEED_OVERRIDE()")
+            self._trace("DISABLE_SPEED_OVERRIDE(0)")
+        feed(bottom)
+        if motion == 840:
+            self._emit(C.SpindleOff(line))
+            self._emit(C.SpindleOn(-1, self.speed, line))
+            self._emit(C.Dwell(dwell, line))
+            feed(clear)
+            self._emit(C.SpindleOff(line))
+            self._emit(C.SpindleOn(1, self.speed, line))
+            self._trace("ENABLE_FEED_OVERRIDE()")
+            self._trace("ENABLE_SPEED_OVERRIDE(0)")
+            return
+        if dwell > 0:
+            self._emit(C.Dwell(dwell, line))
+        if motion == 890:
+            feed(clear)
+        elif motion == 860:
+            self._emit(C.SpindleOff(line))
+            prog[d] = clear
+            self._traverse(self._to_machine(prog), line)
+            self._emit(C.SpindleOn(direction, self.speed, line))
+        else:
+            self._emit(C.SpindleOff(line))
+            self._emit(C.ProgramPause(line))
+            self._emit(C.SpindleOn(direction, self.speed, line))
 
     def _cycle_body(self, motion: int, prog: list[float], d: int, r: float,
                     bottom: float, line: int) -> None:
