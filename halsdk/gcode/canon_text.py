@@ -28,8 +28,13 @@ ARC_AXES = {17: (0, 1, 2), 18: (2, 0, 1), 19: (1, 2, 0)}
 
 
 def f4(value: float) -> str:
-    """``%.4f``, the reference's number format for most arguments."""
-    return f"{value:.4f}"
+    """``%.4f``, the reference's number format for most arguments.
+
+    The value is first rounded to 10 decimals: our positions come back
+    from machine units (inches) with an error in the last bits, which
+    would otherwise decide a tie such as 9.20625 the other way than the
+    reference, which computes in program units."""
+    return f"{round(value, 10):.4f}"
 
 
 class TextCanon(C.Canon):

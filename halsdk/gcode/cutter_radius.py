@@ -1,6 +1,7 @@
-"""Cutter radius compensation (G41/G42) for straight moves in the XY plane.
+"""Cutter radius compensation (G41/G42) for straight moves in the XY plane
+(G17) or the XZ plane (G18).
 
-Supported: straight moves (G0/G1) in G17, with outside corners rounded by an
+Supported: straight moves (G0/G1) in G17 or G18, with outside corners rounded by an
 arc around the programmed corner and inside corners cut at the intersection
 of the two offset lines; moves that leave X and Y unchanged (Z plunges) pass
 through.  The first XY move after G41/G42 is the entry move: it runs straight
@@ -8,7 +9,7 @@ from where the tool is to the offset start of the next corner.  G40 ends the
 offset after the last segment; the following move is the exit move.
 
 Refused with :class:`CutterRadiusError`: arcs, canned cycles, probing and G33 while
-compensation is on, other planes, an inside corner right after a non-XY move,
+compensation is on, G19, an inside corner right after a non-XY move,
 and segments too short for the tool radius (they would gouge).
 """
 
@@ -19,6 +20,11 @@ from dataclasses import dataclass
 from typing import Callable, Optional
 
 from . import canon as C
+
+
+#: plane -> (first, second) axis indices: the in-plane coordinates, in
+#: the order that makes the plane's normal point towards the viewer
+PLANE_AXES = {17: (0, 1), 18: (2, 0)}
 
 
 class CutterRadiusError(Exception):
@@ -51,12 +57,19 @@ class CutterComp:
         self._queue: list[C.Command] = []
         self._last_dir: Optional[tuple[float, float]] = None
         self._at: Optional[tuple[float, float]] = None   # emitted XY
+        self.plane = 17
+        self._a1, self._a2 = PLANE_AXES[17]
 
     @property
     def active(self) -> bool:
         return self.side != 0
 
-    def start(self, side: int, radius: float) -> None:
+    def start(self, side: int, radius: float, plane: int = 17) -> None:
+        if plane not in PLANE_AXES:
+            raise CutterRadiusError("cutter compensation works in the XY "
+                                    "and XZ planes (G17, G18) only")
+        self.plane = plane
+        self._a1, self._a2 = PLANE_AXES[plane]
         if self.active:
             raise CutterRadiusError("cutter compensation is already on (G40 first)")
         if radius < 0:
@@ -83,7 +96,7 @@ class CutterComp:
         seg = self._pending
         assert seg is not None
         end = list(seg.end)
-        end[0], end[1] = xy
+        end[self._a1], end[self._a2] = xy
         pose = tuple(end)
         if seg.feed is None:
             self._send(C.StraightTraverse(pose, seg.line))  # type: ignore
@@ -100,31 +113,33 @@ class CutterComp:
              feed: Optional[float], line: int) -> None:
         """A programmed straight move from ``start`` to ``end`` (machine
         coordinates); ``feed`` None for a traverse."""
-        dx, dy = end[0] - start[0], end[1] - start[1]
+        a1, a2 = self._a1, self._a2
+        dx, dy = end[a1] - start[a1], end[a2] - start[a2]
         length = math.hypot(dx, dy)
         if length < 1e-9:
             # no XY motion: release the held segment, move at its offset end
             if self._pending is not None:
                 seg = self._pending
                 off = self._offset(seg.direction)
-                self._finish_pending((seg.end[0] + off[0],
-                                      seg.end[1] + off[1]))
+                self._finish_pending((seg.end[a1] + off[0],
+                                      seg.end[a2] + off[1]))
             pose = list(end)
             if self._at is not None:
-                pose[0], pose[1] = self._at
+                pose[a1], pose[a2] = self._at
             if feed is None:
                 self._send(C.StraightTraverse(tuple(pose), line))  # type: ignore
             else:
                 self._send(C.StraightFeed(tuple(pose), feed, line))  # type: ignore
             return
         d = (dx / length, dy / length)
-        new = _Segment((start[0], start[1]), list(end), d, length, feed, line)
+        new = _Segment((start[a1], start[a2]), list(end), d, length, feed,
+                       line)
         if self._pending is None and self._last_dir is None:
             self._pending = new            # entry move
             return
         prev = self._pending.direction if self._pending else self._last_dir
         assert prev is not None
-        corner = (start[0], start[1])
+        corner = (start[a1], start[a2])
         off_a, off_b = self._offset(prev), self._offset(d)
         cross = prev[0] * d[1] - prev[1] * d[0]
         dot = prev[0] * d[0] + prev[1] * d[1]
@@ -140,12 +155,13 @@ class CutterComp:
                 self._finish_pending(a_end)
             if self.radius > 0:
                 pose = list(start)
-                pose[0], pose[1] = b_start
+                pose[a1], pose[a2] = b_start
                 arc_feed = feed if feed is not None else None
                 if arc_feed is None:
                     self._send(C.StraightTraverse(tuple(pose), line))  # type: ignore
                 else:
-                    self._send(C.ArcFeed(tuple(pose), corner, 17,  # type: ignore
+                    self._send(C.ArcFeed(tuple(pose), corner,  # type: ignore
+                                         self.plane,
                                          -self.side, arc_feed, line))
             self._at = b_start
         else:                                         # inside corner
@@ -169,7 +185,8 @@ class CutterComp:
         if self._pending is not None:
             seg = self._pending
             off = self._offset(seg.direction)
-            self._finish_pending((seg.end[0] + off[0], seg.end[1] + off[1]))
+            self._finish_pending((seg.end[self._a1] + off[0],
+                                  seg.end[self._a2] + off[1]))
         self.side = 0
         self._last_dir = None
         self._at = None

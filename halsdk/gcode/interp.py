@@ -327,6 +327,10 @@ class Interpreter:
                 raise block.error("negative dwell time", "p")
             self._emit(C.Dwell(p, line))
         if 2 in gs:
+            if self.comp.active and gs[2] != self.modal.plane:
+                raise block.error("cannot change the plane with cutter "
+                                  "compensation on",
+                                  code_key("g", gs[2] / 10))
             self.modal.plane = gs[2]
             self._emit(C.SetPlane(gs[2] // 10, line))
         if 6 in gs:
@@ -712,9 +716,9 @@ class Interpreter:
         if code == 400:
             self.comp.stop()
         else:
-            if self.modal.plane != 170:
-                raise block.error("cutter compensation is only supported in "
-                                  "the XY plane (G17)", key)
+            if self.modal.plane not in (170, 180):
+                raise block.error("cutter compensation works in the XY and "
+                                  "XZ planes (G17, G18) only", key)
             tool = (self._tool_number(block, "d") if "d" in block.words
                     else self.current_tool)
             if "d" in block.words:
@@ -722,7 +726,8 @@ class Interpreter:
             entry = self._tool_of(tool)
             radius = entry.diameter / 2 if entry is not None else 0.0
             try:
-                self.comp.start(1 if code == 410 else -1, radius)
+                self.comp.start(1 if code == 410 else -1, radius,
+                                self.modal.plane // 10)
             except CutterRadiusError as e:
                 raise block.error(str(e), key) from None
         self.modal.cutter_comp = code

@@ -559,7 +559,8 @@ def test_cutter_comp_z_moves_and_refusals():
     assert feeds[:2] == [(-3, 0, 5), (-3, 0, -1)]
     assert xy(rec.of_type(C.ArcFeed)[0]) == (0, 3)
     assert "not supported" in str(err("G41 D1\nG2 X1 Y1 R1 F1\n"))
-    assert "XY plane" in str(err("G18 G41 D1\n"))
+    assert "XZ planes" in str(err("G19 G41 D1\n"))
+    assert "change the plane" in str(err("G18 G41 D1\nG17\n"))
     assert "already on" in str(err("G41 D1\nG42 D1\n"))
     assert "tool 9" in str(err("G41 D9\n"))
 
