@@ -21,7 +21,6 @@ from typing import Callable, Optional
 
 from . import canon as C
 
-
 #: plane -> (first, second) axis indices: the in-plane coordinates, in
 #: the order that makes the plane's normal point towards the viewer
 PLANE_AXES = {17: (0, 1), 18: (2, 0)}
