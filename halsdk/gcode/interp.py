@@ -614,7 +614,7 @@ class Interpreter:
             allowed.add("p")
         elif g0 == 100:
             allowed |= set("lprijq")
-        if gs.get(8) == 430:
+        if gs.get(8) in (430, 432):
             allowed.add("h")
         if gs.get(13) == 640:
             allowed |= set("pq")
@@ -752,12 +752,16 @@ class Interpreter:
                 if a in block.words:
                     offset[i] = block.words[a] * self._k(i)
         else:
+            if code == 432 and "h" not in block.words:
+                raise block.error("G43.2 needs an H word", "g43.2")
             tool = (self._tool_number(block, "h") if "h" in block.words
                     else self.current_tool)
             if "h" in block.words:
                 self._pocket_for(block, tool, "h")
             entry = self._tool_of(tool)
             offset = list(entry.offset) if entry is not None else [0.0] * 9
+            if code == 432:             # added to the offset in force
+                offset = [a + b for a, b in zip(self.tlo, offset)]
         self.modal.tool_length = code
         self.tlo = [float(v) for v in offset]
         self._emit(C.UseToolLengthOffset(_pose(self.tlo), block.line))
@@ -1383,6 +1387,9 @@ class Interpreter:
     # -- predefined named parameters -------------------------------------
     def _predefined(self, name: str) -> Optional[float]:
         name = name.strip("<>").lower()
+        if name.isdigit():              # #5420..#5428
+            i = int(name) - 5420
+            return self.program_position()[i] / self._k(i)
         if len(name) == 2 and name[1] in AXES:
             i = AXES.index(name[1])
             return self.program_position()[i] / self._k(i)

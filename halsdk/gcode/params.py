@@ -17,6 +17,10 @@ PERSISTENT: tuple[int, ...] = tuple(
     + [n for base in range(5221, 5382, 20) for n in range(base, base + 10)]
 )
 
+#: The current position in program coordinates (X .. W), read-only
+#: values the interpreter answers through :meth:`Parameters.set_predefined`.
+POSITION = range(5420, 5429)
+
 #: Numbered parameters local to a subroutine call (its arguments).
 LOCAL_NUMBERED = range(1, 31)
 
@@ -89,8 +93,9 @@ class Parameters:
                        ) -> None:
         """Install the callback answering read-only names such as ``_x``.
 
-        ``fn(name)`` gets the normalized name without ``<>`` and returns
-        its value, or None when it does not know the name.
+        ``fn(name)`` gets the normalized name without ``<>`` (or the
+        number, as a string, of a position parameter #5420..#5428) and
+        returns its value, or None when it does not know it.
         """
         self._predefined = fn
 
@@ -125,6 +130,11 @@ class Parameters:
         number = self._number(key)
         if number in LOCAL_NUMBERED and self.depth:
             return self._frames[-1].numbered.get(number, 0.0)
+        if number in POSITION and self._predefined is not None:
+            # the current position: answered by the interpreter
+            value = self._predefined(str(number))
+            if value is not None:
+                return float(value)
         return self._numbered.get(number, 0.0)
 
     def set(self, key: Key, value: float) -> None:
