@@ -587,6 +587,8 @@ class Interpreter:
                 code_key("g", gs[1] / 10))
         if g0 == 530 and gs.get(1, self.modal.motion) not in (0, 10):
             raise block.error("G53 needs G0 or G1", "g53")
+        if g0 == 530 and gs.get(3, self.modal.distance) == 910:
+            raise block.error("G53 in incremental mode (G91)", "g53")
         motion = gs.get(1, self.modal.motion)
         if axes and not user0 and gs.get(8) != 431 and motion == 800:
             raise block.error(
@@ -711,14 +713,14 @@ class Interpreter:
 
     def _cutter_comp(self, block: Block, code: int) -> None:
         key = code_key("g", code / 10)
+        if code != 400 and self.modal.plane not in (170, 180):
+            raise block.error("cutter compensation works in the XY and "
+                              "XZ planes (G17, G18) only", key)
         self._trace('COMMENT("interpreter: cutter radius compensation '
                     f'{ {400: "off", 410: "on left", 420: "on right"}[code] }")')
         if code == 400:
             self.comp.stop()
         else:
-            if self.modal.plane not in (170, 180):
-                raise block.error("cutter compensation works in the XY and "
-                                  "XZ planes (G17, G18) only", key)
             tool = (self._tool_number(block, "d") if "d" in block.words
                     else self.current_tool)
             if "d" in block.words:
