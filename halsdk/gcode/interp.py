@@ -306,13 +306,13 @@ class Interpreter:
             self._hal_io(block, ms[5])
         if 6 in ms:
             self._tool_change(block, ms[6])
-        if 7 in ms:
+        if 7 in ms:                 # M70-M73 share the spindle's group
             if ms[7] == 190:
                 self._orient(block)
+            elif ms[7] >= 700:
+                self._modal_state(block, ms[7])
             else:
                 self._spindle(ms[7], line)
-        if 10 in ms:
-            self._modal_state(block, ms[10])
         if 8 in ms:
             code = ms[8]
             self.modal.mist = code == 70 or (self.modal.mist and code != 90)
@@ -716,6 +716,8 @@ class Interpreter:
         if code != 400 and self.modal.plane not in (170, 180):
             raise block.error("cutter compensation works in the XY and "
                               "XZ planes (G17, G18) only", key)
+        if code != 400 and "d" in block.words:
+            self._pocket_for(block, self._tool_number(block, "d"), "d")
         self._trace('COMMENT("interpreter: cutter radius compensation '
                     f'{ {400: "off", 410: "on left", 420: "on right"}[code] }")')
         if code == 400:
@@ -845,6 +847,8 @@ class Interpreter:
             digital = "p" in block.words
             index = self._index(block, "p" if digital else "e", "M66")
             mode = int(block.words.get("l", 0))
+            if self.ref:
+                return          # the reference's rs274 prints nothing
             if not 0 <= mode <= 4:
                 raise block.error("M66 L must be 0..4", "l")
             if mode and not digital:
@@ -920,8 +924,6 @@ class Interpreter:
         if code == 640:
             p = block.words.get("p")
             q = block.words.get("q")
-            if q is not None and p is None:
-                raise block.error("G64 Q needs a P word", "q")
             if q is None and p is not None and self.ref:
                 q = p
             self.blend = (None if p is None else self._len(p),
@@ -1226,7 +1228,8 @@ class Interpreter:
             if letter not in self.cycle:
                 raise block.error(f"canned cycle G{motion / 10:g} needs "
                                   f"the word {letter.upper()}", key)
-        if motion in (730, 830) and self.cycle.get("q", 0) <= 0:
+        if motion in (730, 830) and self.cycle.get("q", 0) <= 0 and \
+                not self.ref:
             raise block.error(f"G{motion / 10:g} needs a positive Q word",
                               key)
         if motion == 840 and self.modal.spindle != 30 and not self.ref:
@@ -1261,6 +1264,9 @@ class Interpreter:
         wrap = self.modal.control != 610
         if wrap:
             self._trace("SET_MOTION_CONTROL_MODE(CANON_EXACT_PATH)")
+        if self.ref and motion in (730, 830) and \
+                self.cycle.get("q", 0) <= 0:
+            raise block.error(f"Q word missing with G{motion // 10}", key)
         if self.ref and motion in (820, 860, 880, 890) and \
                 "p" not in self.cycle:
             raise block.error("dwell time P word missing with "

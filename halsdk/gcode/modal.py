@@ -38,10 +38,9 @@ M_GROUPS: dict[int, tuple[int, ...]] = {
     4: (0, 10, 20, 300, 600),
     5: (620, 630, 640, 650, 660, 670, 680),
     6: (60, 610),
-    7: (30, 40, 50, 190),
+    7: (30, 40, 50, 190, 700, 710, 720, 730),
     8: (70, 80, 90),
     9: (480, 490, 500, 510, 520, 530),
-    10: (700, 710, 720, 730),
 }
 _G_OF = {code: group for group, codes in G_GROUPS.items() for code in codes}
 _M_OF = {code: group for group, codes in M_GROUPS.items() for code in codes}
