@@ -22,7 +22,8 @@ Conventions
   spindle and pauses the program so the operator can withdraw the tool by
   hand, then restarts the spindle; it needs the spindle on.
 * G10 L2/L20 R rotates the coordinate system in XY about its origin.
-* Not supported (clear error): G76, G87.
+* G76 threads: passes of growing depth, each a spindle-synchronised feed.
+* Not supported (clear error): G87.
 """
 
 from __future__ import annotations
@@ -74,7 +75,7 @@ ZERO9: C.Pose = (0.0,) * 9
 PLANES = {170: (0, 1, 2, "ij"), 180: (2, 0, 1, "ki"), 190: (1, 2, 0, "jk")}
 COORD_CODES = (540, 550, 560, 570, 580, 590, 591, 592, 593)
 CANNED = (730, 810, 820, 830, 840, 850, 860, 880, 890)
-UNSUPPORTED_MOTION = {760: "G76", 870: "G87"}
+UNSUPPORTED_MOTION = {870: "G87"}
 
 
 def _rotate(x: float, y: float, degrees: float) -> tuple[float, float]:
@@ -131,6 +132,7 @@ class Interpreter:
         self.selected_pocket = -1
         self.diameter_mode = False
         self._previous_motion = 10
+        self._sync: Optional[float] = None      # G76: pitch being synced
         #: the program being run (for M73: its call level)
         self.program: Any = None
         #: M70 state and the M73 state with its call level
@@ -610,6 +612,8 @@ class Interpreter:
             allowed |= set("ijkrp")
         elif moving and motion == 330:
             allowed.add("k")
+        elif moving and motion == 760:
+            allowed |= set("pijkrqhel")
         elif moving and (motion in CANNED or motion in UNSUPPORTED_MOTION):
             allowed |= set("rlpq")
         if g0 == 40:
@@ -1103,8 +1107,100 @@ class Interpreter:
                 self._probe(block, motion, end)
         elif motion in (20, 30):
             self._arc(block, motion)
+        elif motion == 760:
+            self._g76(block)
         else:
             self._canned(block, motion)
+
+    # -- G76 threading ---------------------------------------------------
+    def _g76(self, block: Block) -> None:
+        """The threading cycle: passes of growing depth (J, J*2^(1/R),
+        ... then K), each entered at the compound angle Q, with optional
+        entry/exit tapers (E, L) and H spring passes; ends at the start
+        X and the end Z."""
+        key = "g76"
+        w = block.words
+        for letter in "pzijk":
+            if letter not in w:
+                raise block.error(f"G76 needs the word {letter.upper()}",
+                                  key)
+        k = self._k()
+        half = 0.5 if self.diameter_mode else 1.0
+        pitch = w["p"] * k
+        depth0 = w["j"] * k * half
+        full = w["k"] * k * half
+        offset = w["i"] * k * half
+        degression = w.get("r", 1.0)
+        angle = w.get("q", 0.0)
+        springs = int(w.get("h", 0))
+        taper = w.get("e", 0.0) * k
+        ends = int(w.get("l", 0))
+        if pitch <= 0 or depth0 <= 0 or full <= 0:
+            raise block.error("G76 needs positive P, J and K", key)
+        if degression < 1.0:
+            raise block.error("G76 R (depth degression) must be at least 1",
+                              "r")
+        if springs < 0 or not 0 <= ends <= 3:
+            raise block.error("G76 needs H >= 0 and L 0..3", key)
+        if ends and taper <= 0:
+            raise block.error("G76 L (taper) needs a positive E", "e")
+        prog = self.program_position()
+        start_x, start_z = prog[0], prog[2]
+        end_z = w["z"] * k + (start_z if self.modal.distance == 910 else 0.0)
+        way = -1.0 if end_z < start_z else 1.0
+        inward = 1.0 if offset > 0 else -1.0     # I > 0: internal thread
+        tan_q = math.tan(math.radians(angle))
+        taper_pitch = (pitch * math.hypot(taper, full) / taper
+                       if taper > 0 else pitch)
+        line = block.line
+
+        def at(x: float, z: float) -> list[float]:
+            point = list(prog)
+            point[0], point[2] = x, z
+            return self._to_machine(point)
+
+        def synced(x: float, z: float, rate: float) -> None:
+            end = at(x, z)
+            if self.ref:
+                if self._sync != rate:
+                    self._trace(f"START_SPEED_FEED_SYNC({rate / k:f},0)")
+                    self._sync = rate
+                self._emit(C.StraightFeed(_pose(end), 0.0, line))
+            else:
+                self._emit(C.SyncedFeed(_pose(end), rate, line))
+            self.pos = end
+
+        def thread_pass(depth: float) -> None:
+            # the compound angle moves each pass along Z, away from the
+            # direction of travel by the depth it has reached
+            z0 = start_z + way * depth * tan_q
+            z1 = end_z + way * (depth - full) * tan_q
+            back = start_x + inward * (depth - full)
+            cut = start_x + offset + inward * depth
+            self._traverse(at(back, z0), line)
+            self._sync = None
+            if ends & 1:
+                self._trace("DISABLE_FEED_OVERRIDE()")
+                synced(cut - inward * full, z0, taper_pitch)
+                synced(cut, z0 + way * taper, taper_pitch)
+            else:
+                self._traverse(at(cut, z0), line)
+                self._trace("DISABLE_FEED_OVERRIDE()")
+            synced(cut, z1 - way * taper if ends & 2 else z1, pitch)
+            if ends & 2:
+                synced(cut - inward * full, z1, taper_pitch)
+            self._trace("STOP_SPEED_FEED_SYNCH()")
+            self._traverse(at(back, z1), line)
+            self._trace("ENABLE_FEED_OVERRIDE()")
+
+        n, depth = 1, depth0
+        while depth < full:
+            thread_pass(depth)
+            n += 1
+            depth = depth0 * n ** (1.0 / degression)
+        for _ in range(1 + springs):
+            thread_pass(full)
+        self._traverse(at(start_x, end_z), line)
 
     def _probe(self, block: Block, motion: int, end: list[float]) -> None:
         key = code_key("g", motion / 10)

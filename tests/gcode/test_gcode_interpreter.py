@@ -632,3 +632,18 @@ def test_m70_m72_and_m73_restore_the_modal_state():
     assert interp.modal.units == 210 and interp.modal.distance == 900
     assert moves(rec)[-1].end[0] == pytest.approx(1)
     assert "M72 without" in str(err("M70\nM71\nM72\n"))
+
+
+def test_g76_threading_passes():
+    # external thread from X1 Z1 to Z-1: depths 0.02, 0.04, then K 0.05
+    _, rec = run("G18 G0 X1 Z1\nG76 P0.1 Z-1 I-0.1 J0.02 K0.05\n")
+    synced = rec.of_type(C.SyncedFeed)
+    assert [round(c.end[0], 6) for c in synced] == [0.88, 0.86, 0.85]
+    assert all(c.pitch == pytest.approx(0.1) for c in synced)
+    assert all(round(c.end[2], 6) == -1 for c in synced)
+    # it ends at the start X and the end Z
+    assert xyz(moves(rec)[-1]) == (1, 0, -1)
+    # a spring pass repeats the last depth
+    _, rec = run("G18 G0 X1 Z1\nG76 P0.1 Z-1 I-0.1 J0.02 K0.05 H1\n")
+    assert len(rec.of_type(C.SyncedFeed)) == 4
+    assert "needs the word K" in str(err("G76 P0.1 Z-1 I-0.1 J0.02\n"))
