@@ -14,8 +14,8 @@ Conventions
   the way the developer manual's tool section describes, and the matching
   canon commands let the machine layer update its copy.
 * Cutter radius compensation (G41/G42 with D = tool number, radius from
-  the tool table) covers straight moves in G17; see cutter_radius for what
-  is refused.
+  the tool table) covers lines and arcs in G17 and G18; see cutter_radius
+  for what is refused.
 * G84 is the floating-chuck tap of the reference manual: feed in, spindle
   reversed for a feed out at the same rate, no spindle synchronisation;
   it needs the spindle on clockwise (M3).  G88 feeds in, dwells, stops the
@@ -1068,11 +1068,11 @@ class Interpreter:
         line = block.line
         key = code_key("g", motion / 10)
         g53 = gs.get(0) == 530
-        if self.comp.active and (motion not in (0, 10) or g53):
+        if self.comp.active and (motion not in (0, 10, 20, 30) or g53):
             raise block.error(f"G{'53' if g53 else f'{motion / 10:g}'} "
                               "while cutter compensation is on is not "
                               "supported", "g53" if g53 else key)
-        if self.comp.active and has_axes:
+        if self.comp.active and has_axes and motion in (0, 10):
             end = self._target(block)
             feed = None
             if motion == 10:
@@ -1288,8 +1288,16 @@ class Interpreter:
         length = self._arc_length(start, end, (c1, c2), a1, a2, turn)
         feed = self._feed_for(block, length)
         self._inverse_time_trace(length)
-        self._emit(C.ArcFeed(_pose(end), (c1, c2), self.modal.plane // 10,
-                             turn, feed, block.line))
+        if self.comp.active:
+            try:
+                self.comp.arc(self.pos, end, (c1, c2), turn, feed,
+                              block.line)
+            except CutterRadiusError as e:
+                raise block.error(str(e), key) from None
+        else:
+            self._emit(C.ArcFeed(_pose(end), (c1, c2),
+                                 self.modal.plane // 10, turn, feed,
+                                 block.line))
         self.pos = list(end)
 
     @staticmethod

@@ -558,7 +558,7 @@ def test_cutter_comp_z_moves_and_refusals():
              for c in rec.of_type(C.StraightFeed)]
     assert feeds[:2] == [(-3, 0, 5), (-3, 0, -1)]
     assert xy(rec.of_type(C.ArcFeed)[0]) == (0, 3)
-    assert "not supported" in str(err("G41 D1\nG2 X1 Y1 R1 F1\n"))
+    assert "too big" in str(err("G0 X-9\nG41 D1 G1 X0 F1\nG3 X4 R2\n"))
     assert "XZ planes" in str(err("G19 G41 D1\n"))
     assert "change the plane" in str(err("G18 G41 D1\nG17\n"))
     assert "already on" in str(err("G41 D1\nG42 D1\n"))
@@ -647,3 +647,16 @@ def test_g76_threading_passes():
     _, rec = run("G18 G0 X1 Z1\nG76 P0.1 Z-1 I-0.1 J0.02 K0.05 H1\n")
     assert len(rec.of_type(C.SyncedFeed)) == 4
     assert "needs the word K" in str(err("G76 P0.1 Z-1 I-0.1 J0.02\n"))
+
+
+def test_cutter_comp_on_arcs_meets_the_offset_lines():
+    # tool radius 3 left of a clockwise arc: its offset path has radius 13
+    _, rec = run("G0 X-10 Y0\nG41 D1 G1 X0 Y0 F100\nG2 X20 Y0 I10 J0\n"
+                 "G1 X30\nG40\n")
+    feeds = rec.of_type(C.StraightFeed)
+    h = math.sqrt(13 ** 2 - 3 ** 2)
+    assert xyz(feeds[0]) == pytest.approx((10 - h, 3, 0))
+    arc = rec.of_type(C.ArcFeed)[0]
+    assert arc.center == pytest.approx((10, 0)) and arc.turn == -1
+    assert xyz(arc) == pytest.approx((10 + h, 3, 0))
+    assert xyz(feeds[1]) == pytest.approx((30, 3, 0))
