@@ -616,6 +616,8 @@ class Interpreter:
             allowed |= set("pijkrqhel")
         elif moving and (motion in CANNED or motion in UNSUPPORTED_MOTION):
             allowed |= set("rlpq")
+            if motion == 870:
+                allowed |= set("ijk")
         if g0 == 40:
             allowed.add("p")
         elif g0 == 100:
@@ -707,7 +709,10 @@ class Interpreter:
             pocket = self._pocket_for(block, tool, "q")
             self._emit(C.ChangeToolNumber(tool, pocket, block.line))
             if not self.random:
-                self._load_spindle(pocket)
+                # (the reference's rs274 leaves its spindle entry as it
+                # was: a G43 after M61 applies no offset there)
+                if not self.ref:
+                    self._load_spindle(pocket)
             elif pocket != 0:
                 old, new = self.tools.entry(0), self.tools.entry(pocket)
                 self.tools.set_entry(0, replace(new, pocket=0))
@@ -767,6 +772,9 @@ class Interpreter:
             if "h" in block.words:
                 self._pocket_for(block, tool, "h")
             entry = self._tool_of(tool)
+            if self.ref and "h" not in block.words and \
+                    self.tools is not None:
+                entry = self.tools.entry(0)      # the spindle's entry
             offset = list(entry.offset) if entry is not None else [0.0] * 9
             if code == 432:             # added to the offset in force
                 offset = [a + b for a, b in zip(self.tlo, offset)]
@@ -1051,7 +1059,7 @@ class Interpreter:
         explicit = gs.get(1)
         self._previous_motion = self.modal.motion
         if explicit is not None:
-            if explicit in UNSUPPORTED_MOTION:
+            if explicit in UNSUPPORTED_MOTION and not self.ref:
                 raise block.error(f"{UNSUPPORTED_MOTION[explicit]} is not "
                                   "supported", code_key("g", explicit / 10))
             self.modal.motion = explicit
@@ -1325,7 +1333,7 @@ class Interpreter:
         line = block.line
         a1, a2, d, _ = PLANES[self.modal.plane]
         dl = AXES[d]
-        for letter in ("r", dl, "p", "q"):
+        for letter in ("r", dl, "p", "q", "i", "j", "k"):
             if letter in block.words:
                 self.cycle[letter] = block.words[letter]
         for letter in ("r", dl):
@@ -1368,6 +1376,11 @@ class Interpreter:
         wrap = self.modal.control != 610
         if wrap:
             self._trace("SET_MOTION_CONTROL_MODE(CANON_EXACT_PATH)")
+        if self.ref and motion == 870:
+            for letter in "ijk":
+                if letter not in self.cycle:
+                    raise block.error(f"G87 needs the word {letter.upper()}",
+                                      key)
         if self.ref and motion in (730, 830) and \
                 self.cycle.get("q", 0) <= 0:
             raise block.error(f"Q word missing with G{motion // 10}", key)
@@ -1385,7 +1398,7 @@ class Interpreter:
             if not (self.ref and prog[d] == r):
                 prog[d] = r
                 self._traverse(self._to_machine(prog), line)
-            if self.ref and motion in (840, 860, 880, 890):
+            if self.ref and motion in (840, 860, 870, 880, 890):
                 self._reference_cycle_body(motion, prog, d, bottom, clear,
                                            line)
                 continue
@@ -1411,6 +1424,9 @@ class Interpreter:
 
         dwell = self.cycle.get("p", 0.0)
         direction = 1 if self.modal.spindle == 30 else -1
+        if motion == 870:
+            self._back_bore(prog, d, bottom, clear, direction, line)
+            return
         if motion == 840 and self.modal.spindle != 30:
             block = self.line_block
             assert block is not None
@@ -1443,6 +1459,45 @@ class Interpreter:
             self._emit(C.SpindleOff(line))
             self._emit(C.ProgramPause(line))
             self._emit(C.SpindleOn(direction, self.speed, line))
+
+    def _back_bore(self, prog: list[float], d: int, bottom: float,
+                   clear: float, direction: int, line: int) -> None:
+        """G87 as the reference's rs274 runs it: off to the side by I/J,
+        spindle stopped and oriented, down below the part, back to the
+        centre, bore up to K and down again, then out the same way."""
+        block = self.line_block
+        assert block is not None
+        a1, a2, _, _ = PLANES[self.modal.plane]
+        words = self.cycle
+        k = self._k()
+        x, y = prog[a1], prog[a2]
+        off_x, off_y = x + words["i"] * k, y + words["j"] * k
+        top = words["k"] * k
+
+        def go(px: float, py: float, z: float, feed: bool = False) -> None:
+            prog[a1], prog[a2], prog[d] = px, py, z
+            end = self._to_machine(prog)
+            if feed:
+                self._emit(C.StraightFeed(_pose(end), self.feed, line))
+                self.pos = end
+            else:
+                self._traverse(end, line)
+
+        go(off_x, off_y, prog[d])
+        orient = f"ORIENT_SPINDLE(0, 0.0000, {2 if direction > 0 else 3})"
+        self._emit(C.SpindleOff(line))
+        self._trace(orient)
+        go(off_x, off_y, bottom)
+        go(x, y, bottom)
+        self._emit(C.SpindleOn(direction, self.speed, line))
+        go(x, y, top, feed=True)
+        go(x, y, bottom, feed=True)
+        self._emit(C.SpindleOff(line))
+        self._trace(orient)
+        go(off_x, off_y, bottom)
+        go(off_x, off_y, clear)
+        go(x, y, clear)
+        self._emit(C.SpindleOn(direction, self.speed, line))
 
     def _cycle_body(self, motion: int, prog: list[float], d: int, r: float,
                     bottom: float, line: int) -> None:
