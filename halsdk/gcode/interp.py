@@ -85,6 +85,16 @@ def _rotate(x: float, y: float, degrees: float) -> tuple[float, float]:
     return x * c - y * s, x * s + y * c
 
 
+def _bezier(points: list[tuple[float, float]], t: float
+            ) -> tuple[float, float]:
+    """The point at ``t`` of the Bezier curve of ``points`` (de Casteljau)."""
+    pts = list(points)
+    while len(pts) > 1:
+        pts = [((1 - t) * a[0] + t * b[0], (1 - t) * a[1] + t * b[1])
+               for a, b in zip(pts, pts[1:])]
+    return pts[0]
+
+
 def _pose(values: Any) -> C.Pose:
     return tuple(float(v) for v in values)  # type: ignore[return-value]
 
@@ -133,6 +143,7 @@ class Interpreter:
         self.diameter_mode = False
         self._previous_motion = 10
         self._sync: Optional[float] = None      # G76: pitch being synced
+        self._spline_pq = (0.0, 0.0)            # G5: the last P, Q
         #: the program being run (for M73: its call level)
         self.program: Any = None
         #: M70 state and the M73 state with its call level
@@ -592,6 +603,8 @@ class Interpreter:
         if g0 == 530 and gs.get(3, self.modal.distance) == 910:
             raise block.error("G53 in incremental mode (G91)", "g53")
         motion = gs.get(1, self.modal.motion)
+        if 1 not in gs and motion in (50, 51):
+            motion = 800        # a spline is not repeated by axis words
         if axes and not user0 and gs.get(8) != 431 and motion == 800:
             raise block.error(
                 f"{axes[0].upper()} word with no G code to use it", axes[0])
@@ -614,6 +627,8 @@ class Interpreter:
             allowed.add("k")
         elif moving and motion == 760:
             allowed |= set("pijkrqhel")
+        elif moving and motion in (50, 51):
+            allowed |= set("ijpq")
         elif moving and (motion in CANNED or motion in UNSUPPORTED_MOTION):
             allowed |= set("rlpq")
             if motion == 870:
@@ -1117,8 +1132,75 @@ class Interpreter:
             self._arc(block, motion)
         elif motion == 760:
             self._g76(block)
+        elif motion in (50, 51):
+            self._spline(block, motion)
         else:
             self._canned(block, motion)
+
+    # -- G5, G5.1 splines ----------------------------------------------------
+    def _spline(self, block: Block, motion: int) -> None:
+        """G5 cubic and G5.1 quadratic B-splines in the XY plane. rs274
+        prints the reference's NURBS_FEED call; a machine gets straight
+        feeds within 1 um (0.00004 in) of the curve."""
+        key = code_key("g", motion / 10)
+        w = block.words
+        if self.modal.plane != 170:
+            raise block.error("splines must be in the XY plane (G17)", key)
+        if any(a in w for a in "zabcuvw"):
+            raise block.error("splines may not move Z, A, B, C, U, V or W",
+                              key)
+        k = self._k()
+        start = list(self.pos)
+        end = self._target(block)
+        p0 = (start[0], start[1])
+        p3 = (end[0], end[1])
+        if motion == 50:
+            if "p" not in w or "q" not in w:
+                raise block.error("G5 needs both P and Q", key)
+            if "i" in w or "j" in w:
+                c1 = (w.get("i", 0.0) * k, w.get("j", 0.0) * k)
+            elif self._previous_motion == 50:
+                # the reflection of the last G5's second control point
+                c1 = (-self._spline_pq[0], -self._spline_pq[1])
+            else:
+                c1 = (0.0, 0.0)
+            pq = (w["p"] * k, w["q"] * k)
+            if self.rotation:
+                c1 = _rotate(c1[0], c1[1], self.rotation)
+                pq = _rotate(pq[0], pq[1], self.rotation)
+            controls = [p0, (p0[0] + c1[0], p0[1] + c1[1]),
+                        (p3[0] + pq[0], p3[1] + pq[1]), p3]
+            self._spline_pq = pq
+        else:
+            if "i" not in w or "j" not in w:
+                raise block.error("G5.1 needs both I and J", key)
+            c1 = (w["i"] * k, w["j"] * k)
+            if self.rotation:
+                c1 = _rotate(c1[0], c1[1], self.rotation)
+            controls = [p0, (p0[0] + c1[0], p0[1] + c1[1]), p3]
+        feed = self._feed_for(block, math.dist(p0, p3))
+        if self.ref:
+            self._trace(f"NURBS_FEED({len(controls)}, ...)")
+            self.pos = list(end)
+            return
+        n = self._spline_segments(controls)
+        for step in range(1, n + 1):
+            x, y = _bezier(controls, step / n)
+            point = list(end)
+            point[0], point[1] = x, y
+            self._emit(C.StraightFeed(_pose(point), feed, block.line))
+        self.pos = list(end)
+
+    def _spline_segments(self, controls: list[tuple[float, float]]) -> int:
+        """Segments that keep the chords within the tolerance: a chord
+        strays at most |B''| / (8 n^2) from the curve."""
+        degree = len(controls) - 1
+        bend = max(math.dist((0.0, 0.0), (
+            a[0] - 2 * b[0] + c[0], a[1] - 2 * b[1] + c[1]))
+            for a, b, c in zip(controls, controls[1:], controls[2:]))
+        second = degree * (degree - 1) * bend
+        tol = 0.001 if self.machine_metric else 0.00004
+        return max(1, min(1000, math.ceil(math.sqrt(second / (8 * tol)))))
 
     # -- G76 threading ---------------------------------------------------
     def _g76(self, block: Block) -> None:

@@ -660,3 +660,18 @@ def test_cutter_comp_on_arcs_meets_the_offset_lines():
     assert arc.center == pytest.approx((10, 0)) and arc.turn == -1
     assert xyz(arc) == pytest.approx((10 + h, 3, 0))
     assert xyz(feeds[1]) == pytest.approx((30, 3, 0))
+
+
+def test_g5_splines_become_short_feeds_on_the_curve():
+    _, rec = run("G5 I0 J10 P0 Q10 X10 Y0 F100\n")
+    feeds = rec.of_type(C.StraightFeed)
+    assert len(feeds) > 10
+    assert xyz(feeds[-1]) == (10, 0, 0)
+    # the curve 0,0 -> 10,0 with controls (0,10), (10,10) peaks at 7.5
+    assert max(c.end[1] for c in feeds) == pytest.approx(7.5, abs=1e-3)
+    # G5.1: a parabola through its control's midpoints; both I and J
+    _, rec = run("G5.1 I5 J10 X10 Y0 F100\n")
+    assert max(c.end[1] for c in rec.of_type(C.StraightFeed)) == \
+        pytest.approx(5, abs=1e-3)
+    assert "both I and J" in str(err("G5.1 I5 X10 F100\n"))
+    assert "XY plane" in str(err("G18 G5 I1 J1 P1 Q1 X1 F100\n"))
