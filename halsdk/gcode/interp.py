@@ -31,7 +31,7 @@ from __future__ import annotations
 import math
 import re
 from dataclasses import replace
-from typing import Any, Optional
+from typing import Any, Callable, Optional
 
 from . import canon as C
 from .block import Block, code_key
@@ -43,9 +43,9 @@ _DEBUG_PARAM = re.compile(r"#\s*<([^>]*)>|#\s*(\d+)")
 
 def last_comment(text: str) -> Optional[tuple[str, str]]:
     """The last ``( )`` comment of a line as ``(kind, text)``: kind is
-    'msg', 'debug', 'print' or '' (plain); the text after the comma is
-    kept as written.  ``;`` ends the scan (the reference does not report
-    ``;`` comments)."""
+    'msg', 'debug', 'print', 'log', 'logopen', 'logappend', 'logclose'
+    or '' (plain); the text after the comma is kept as written.  ``;``
+    ends the scan (the reference does not report ``;`` comments)."""
     found: Optional[tuple[str, str]] = None
     i = 0
     while i < len(text):
@@ -59,8 +59,11 @@ def last_comment(text: str) -> Optional[tuple[str, str]]:
             body = text[i + 1:end]
             head, comma, rest = body.partition(",")
             kind = "".join(head.split()).lower()
-            if comma and kind in ("msg", "debug", "print"):
+            if comma and kind in ("msg", "debug", "print", "log",
+                                  "logopen", "logappend"):
                 found = (kind, rest)
+            elif kind == "logclose":
+                found = (kind, "")
             else:
                 found = ("", body)
             i = end + 1
@@ -104,7 +107,9 @@ class Interpreter:
 
     def __init__(self, params: Any, tools: Any, canon: C.Canon, *,
                  random_toolchanger: bool = False, units: str = "mm",
-                 program_units: Optional[str] = None) -> None:
+                 program_units: Optional[str] = None,
+                 ini: Optional[Callable[[str, str], Optional[str]]] = None
+                 ) -> None:
         program_units = program_units or units
         for value in (units, program_units):
             if value not in ("mm", "inch"):
@@ -113,6 +118,8 @@ class Interpreter:
         self.params = params
         self.tools = tools
         self.canon = canon
+        #: ``ini(SECTION, KEY)``: the INI value behind ``#<_ini[s]k>``
+        self.ini = ini
         #: emit the reference's informational calls (COMMENT, START_CHANGE
         #: ...) as Trace commands: only for canons that ask for them
         self.ref = bool(getattr(canon, "reference_calls", False))
@@ -254,8 +261,14 @@ class Interpreter:
             self._trace(f'MESSAGE("{text}")')
         elif kind == "debug":
             self._trace(f'MESSAGE("{self._substitute(text)}")')
-        else:
+        elif kind == "print":
             self._trace(self._substitute(text), "print")
+        elif kind == "log":
+            self._trace(f'LOG("{self._substitute(text)}")')
+        elif kind == "logclose":
+            self._trace("LOGCLOSE()")
+        else:                       # logopen, logappend
+            self._trace(f'{kind.upper()}("{text.strip()}")')
 
     def _substitute(self, text: str) -> str:
         def one(match: re.Match[str]) -> str:
@@ -1634,8 +1647,24 @@ class Interpreter:
                                        self.speed, line))
 
     # -- predefined named parameters -------------------------------------
+    def _ini_value(self, name: str) -> Optional[float]:
+        """``#<_ini[section]key>``: section and key upper case, as the
+        reference looks them up; None (not defined) unless numeric."""
+        if self.ini is None:
+            return None
+        section, _, key = name[len("_ini["):].partition("]")
+        text = self.ini(section.upper(), key.upper())
+        if text is None:
+            return None
+        try:
+            return float(text)
+        except ValueError:
+            return None
+
     def _predefined(self, name: str) -> Optional[float]:
         name = name.strip("<>").lower()
+        if name.startswith("_ini[") and "]" in name:
+            return self._ini_value(name)
         if name.isdigit():              # #5420..#5428
             i = int(name) - 5420
             return self.program_position()[i] / self._k(i)

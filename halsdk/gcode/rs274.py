@@ -15,12 +15,12 @@ built-in three-tool table; without ``-v`` every parameter starts at 0
 from __future__ import annotations
 
 import argparse
-import configparser
 import os
 import sys
 from typing import IO, Any, Callable, Optional
 
 from halsdk import console
+from halsdk.ini import IniFile
 
 from .canon_text import TextCanon
 from .errors import GCodeError
@@ -60,7 +60,8 @@ def _parser() -> argparse.ArgumentParser:
                         "parameter starts at 0)")
     p.add_argument("-i", metavar="file.ini",
                    help="INI file: [RS274NGC]PARAMETER_FILE (unless -v) and "
-                        "SUBROUTINE_PATH are read")
+                        "SUBROUTINE_PATH are read, and #<_ini[SECTION]KEY> "
+                        "reads its numeric values")
     p.add_argument("-n", type=int, choices=(0, 1, 2), default=2,
                    help="what to do after an error: 2 stop (default); "
                         "0 and 1 (continue, MDI) are accepted and also stop")
@@ -83,18 +84,6 @@ def _parser() -> argparse.ArgumentParser:
     return p
 
 
-def _ini(path: str) -> dict[str, str]:
-    """The [RS274NGC] keys of an INI file (upper case)."""
-    parser = configparser.ConfigParser(strict=False, interpolation=None,
-                                       inline_comment_prefixes=("#", ";"))
-    parser.optionxform = str  # type: ignore[assignment,method-assign]
-    with open(path, encoding="utf-8") as f:
-        parser.read_file(f)
-    if not parser.has_section("RS274NGC"):
-        return {}
-    return {k.upper(): v for k, v in parser.items("RS274NGC")}
-
-
 def _finished_with_percent(text: str) -> bool:
     """The program is enclosed in % lines (the reference prints FINISH())."""
     lines = [ln.strip() for ln in text.splitlines() if ln.strip()]
@@ -113,7 +102,8 @@ def _source_line(text: str, file: str, exc: GCodeError) -> Optional[str]:
 def run(text: str, file: str, write: Callable[[str], Any],
         error: Callable[[str], Any], *, tool_file: Optional[str] = None,
         var_file: Optional[str] = None, block_delete: bool = False,
-        search_path: tuple[str, ...] = ()) -> int:
+        search_path: tuple[str, ...] = (),
+        ini: Optional[Callable[[str, str], Optional[str]]] = None) -> int:
     """Interpret ``text`` and ``write`` the reference's lines; errors go to
     ``error``.  The exit status: 0, or 1 after an error."""
     from halsdk.machine.tooltable import ToolTable, ToolTableError
@@ -136,7 +126,7 @@ def run(text: str, file: str, write: Callable[[str], Any],
     canon = TextCanon(write)
     status = 0
     interp = Interpreter(params, tools, canon, units="inch",
-                         program_units="mm")
+                         program_units="mm", ini=ini)
     canon.interp = interp
     canon.start()
     try:
@@ -156,7 +146,8 @@ def run(text: str, file: str, write: Callable[[str], Any],
             error(source + "\n")
         status = 1
     canon.call("ON_RESET()")
-    canon.call("ON_RESET()")
+    if ini is None:             # (the reference prints one less with -i)
+        canon.call("ON_RESET()")
     if var_file:
         try:
             params.save(var_file)
@@ -175,17 +166,21 @@ def _main(argv: Optional[list[str]] = None) -> int:
     a = _parser().parse_args(sys.argv[1:] if argv is None else argv)
     var_file = a.v
     search: tuple[str, ...] = ()
+    ini = None
     if a.i:
         try:
-            keys = _ini(a.i)
-        except (OSError, configparser.Error) as exc:
-            print(f"rs274: cannot read {a.i}: {exc}", file=sys.stderr)
+            ini = IniFile(a.i)
+        except OSError as exc:
+            print(f"rs274: cannot read {a.i}: {exc.strerror}",
+                  file=sys.stderr)
             return 1
         base = os.path.dirname(os.path.abspath(a.i))
-        if var_file is None and keys.get("PARAMETER_FILE"):
-            var_file = os.path.join(base, keys["PARAMETER_FILE"])
-        search = tuple(os.path.join(base, d) for d in
-                       keys.get("SUBROUTINE_PATH", "").split(":") if d)
+        parameter_file = ini.get("RS274NGC", "PARAMETER_FILE")
+        if var_file is None and parameter_file:
+            var_file = os.path.join(base, parameter_file)
+        search = tuple(os.path.join(base, d.strip()) for d in
+                       (ini.get("RS274NGC", "SUBROUTINE_PATH") or ""
+                        ).split(":") if d.strip())
     if a.input and a.input != "-":
         try:
             with open(a.input, encoding="utf-8") as f:
@@ -209,7 +204,7 @@ def _main(argv: Optional[list[str]] = None) -> int:
     try:
         return run(text, name, out.write, sys.stderr.write,
                    tool_file=a.t, var_file=var_file, block_delete=a.b,
-                   search_path=search)
+                   search_path=search, ini=None if ini is None else ini.get)
     finally:
         if out is not sys.stdout:
             out.close()

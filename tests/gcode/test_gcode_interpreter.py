@@ -675,3 +675,20 @@ def test_g5_splines_become_short_feeds_on_the_curve():
         pytest.approx(5, abs=1e-3)
     assert "both I and J" in str(err("G5.1 I5 X10 F100\n"))
     assert "XY plane" in str(err("G18 G5 I1 J1 P1 Q1 X1 F100\n"))
+
+
+def test_ini_named_parameters_read_the_ini_upper_case():
+    values = {("AXIS_X", "MAX_LIMIT"): "10.5", ("SETUP", "NAME"): "text"}
+    interp, rec = make()
+    interp.ini = lambda section, key: values.get((section, key))
+    interp.run(Program("G0 X#<_ini[axis_x]max_limit>\n"
+                       "#1 = [EXISTS[#<_ini[AXIS_X]NOPE>]]\n",
+                       params=interp.params))
+    assert xyz(moves(rec)[-1]) == (10.5, 0, 0)
+    assert interp.params.get(1) == 0
+    with pytest.raises(GCodeError, match="not defined"):
+        interp.run(Program("#2 = #<_ini[setup]name>\n",
+                           params=interp.params))
+    with pytest.raises(GCodeError, match="read-only"):
+        interp.run(Program("#<_ini[axis_x]max_limit> = 1\n",
+                           params=interp.params))

@@ -26,6 +26,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from halsdk.gcode.rs274 import run
+from halsdk.ini import IniFile
 
 HERE = Path(__file__).resolve().parent / "programs"
 
@@ -81,9 +82,11 @@ def ours(prog: Path, tmp_path: Path) -> tuple[str, int]:
     if var.exists():
         var_file = str(tmp_path / "prog.var")
         (tmp_path / "prog.var").write_bytes(var.read_bytes())
+    ini = prog.with_suffix(".ini")
     status = run(prog.read_text(encoding="utf-8"), str(prog), out.write,
                  err.write, tool_file=str(tbl) if tbl.exists() else None,
-                 var_file=var_file, search_path=(str(prog.parent),))
+                 var_file=var_file, search_path=(str(prog.parent),),
+                 ini=IniFile(str(ini)).get if ini.exists() else None)
     return out.getvalue(), status
 
 

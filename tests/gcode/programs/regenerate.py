@@ -6,8 +6,9 @@
 For every program ``GROUP/NAME.ngc`` under this folder (or only those
 whose ``GROUP/NAME`` is given) it runs the reference's standalone
 interpreter, ``reference rs274 -g prog.ngc``, in a fresh folder under
-/tmp holding a copy of the program, of ``NAME.tbl`` (passed as ``-t``)
-and ``NAME.var`` (passed as ``-v``) when they exist, and of the library
+/tmp holding a copy of the program, of ``NAME.tbl`` (passed as ``-t``),
+``NAME.ini`` (passed as ``-i``) and ``NAME.var`` (passed as ``-v``) when
+they exist, and of the library
 files of the group (``.ngc`` files whose first line starts with
 ``o<``: subroutine files, not programs). It writes next to the program:
 
@@ -57,6 +58,10 @@ def run_one(prog: Path, reference: str) -> int:
         if tbl.exists():
             shutil.copy(tbl, work / "tool.tbl")
             args += ["-t", "tool.tbl"]
+        ini = prog.with_suffix(".ini")
+        if ini.exists():
+            shutil.copy(ini, work / "prog.ini")
+            args += ["-i", "prog.ini"]
         var = prog.with_suffix(".var")
         if var.exists():
             shutil.copy(var, work / "prog.var")
