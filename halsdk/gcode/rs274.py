@@ -63,8 +63,9 @@ def _parser() -> argparse.ArgumentParser:
                         "SUBROUTINE_PATH are read, and #<_ini[SECTION]KEY> "
                         "reads its numeric values")
     p.add_argument("-n", type=int, choices=(0, 1, 2), default=2,
-                   help="what to do after an error: 2 stop (default); "
-                        "0 and 1 (continue, MDI) are accepted and also stop")
+                   help="what to do after an error: 2 stop (default), 0 "
+                        "report it and go on with the next line; 1 (MDI "
+                        "in the reference) stops like 2")
     p.add_argument("-b", action="store_true",
                    help="toggle block delete (default off: lines starting "
                         "with '/' run)")
@@ -103,9 +104,13 @@ def run(text: str, file: str, write: Callable[[str], Any],
         error: Callable[[str], Any], *, tool_file: Optional[str] = None,
         var_file: Optional[str] = None, block_delete: bool = False,
         search_path: tuple[str, ...] = (),
-        ini: Optional[Callable[[str, str], Optional[str]]] = None) -> int:
+        ini: Optional[Callable[[str, str], Optional[str]]] = None,
+        keep_going: bool = False) -> int:
     """Interpret ``text`` and ``write`` the reference's lines; errors go to
-    ``error``.  The exit status: 0, or 1 after an error."""
+    ``error``.  The exit status: 0, or 1 after an error.  With
+    ``keep_going`` (``-n 0``) a line the interpreter refuses is reported
+    and skipped, and the status stays 0; an error in reading the program
+    still ends it."""
     from halsdk.machine.tooltable import ToolTable, ToolTableError
 
     try:
@@ -129,10 +134,26 @@ def run(text: str, file: str, write: Callable[[str], Any],
                          program_units="mm", ini=ini)
     canon.interp = interp
     canon.start()
+    def report(exc: GCodeError) -> None:
+        error(f"{exc}\n")
+        source = _source_line(text, file, exc)
+        if source is not None:
+            error(source + "\n")
+
     try:
         program = Program(text, file, params, search_path,
                           block_delete=block_delete)
-        interp.run(program)
+        interp.program = program
+        for block in program.blocks():
+            try:
+                interp.execute(block)
+            except GCodeError as exc:
+                if not keep_going:
+                    raise
+                report(exc)         # -n 0: the next line runs
+            if interp.ended:
+                break
+        interp.comp.stop()
         if not interp.ended:
             if not _finished_with_percent(text):
                 lines = text.splitlines()
@@ -140,10 +161,7 @@ def run(text: str, file: str, write: Callable[[str], Any],
                                  "program end", file, len(lines))
             canon.call("FINISH()")
     except GCodeError as exc:
-        error(f"{exc}\n")
-        source = _source_line(text, file, exc)
-        if source is not None:
-            error(source + "\n")
+        report(exc)
         status = 1
     canon.call("ON_RESET()")
     if ini is None:             # (the reference prints one less with -i)
@@ -204,7 +222,8 @@ def _main(argv: Optional[list[str]] = None) -> int:
     try:
         return run(text, name, out.write, sys.stderr.write,
                    tool_file=a.t, var_file=var_file, block_delete=a.b,
-                   search_path=search, ini=None if ini is None else ini.get)
+                   search_path=search, ini=None if ini is None else ini.get,
+                   keep_going=a.n == 0)
     finally:
         if out is not sys.stdout:
             out.close()

@@ -83,10 +83,15 @@ def ours(prog: Path, tmp_path: Path) -> tuple[str, int]:
         var_file = str(tmp_path / "prog.var")
         (tmp_path / "prog.var").write_bytes(var.read_bytes())
     ini = prog.with_suffix(".ini")
+    extra = prog.with_suffix(".args")
+    options = extra.read_text().split() if extra.exists() else []
+    assert set(options) <= {"-b", "-n", "0", "2"}, options
     status = run(prog.read_text(encoding="utf-8"), str(prog), out.write,
                  err.write, tool_file=str(tbl) if tbl.exists() else None,
                  var_file=var_file, search_path=(str(prog.parent),),
-                 ini=IniFile(str(ini)).get if ini.exists() else None)
+                 ini=IniFile(str(ini)).get if ini.exists() else None,
+                 block_delete="-b" in options,
+                 keep_going="-n 0" in " ".join(options))
     return out.getvalue(), status
 
 

@@ -8,7 +8,8 @@ whose ``GROUP/NAME`` is given) it runs the reference's standalone
 interpreter, ``reference rs274 -g prog.ngc``, in a fresh folder under
 /tmp holding a copy of the program, of ``NAME.tbl`` (passed as ``-t``),
 ``NAME.ini`` (passed as ``-i``) and ``NAME.var`` (passed as ``-v``) when
-they exist, and of the library
+they exist (``NAME.args`` holds more options, ``-b`` or ``-n 0``), and of
+the library
 files of the group (``.ngc`` files whose first line starts with
 ``o<``: subroutine files, not programs). It writes next to the program:
 
@@ -71,6 +72,9 @@ def run_one(prog: Path, reference: str) -> int:
                 shutil.copy(lib, work / lib.name)
         for f in work.iterdir():
             os.chmod(f, 0o644)
+        extra = prog.with_suffix(".args")
+        if extra.exists():
+            args += extra.read_text().split()
         args.append("prog.ngc")
         done = subprocess.run(args, cwd=work, capture_output=True,
                               timeout=60)
