@@ -679,14 +679,18 @@ class Interpreter:
     def _update_tool_params(self) -> None:
         entry = self._tool_of(self.current_tool)
         p = self.params
-        p.set(5400, max(self.current_tool, 0))
+        p.set(5400, max(self.current_tool, 0), internal=True)
         offset = entry.offset if entry is not None else ZERO9
         for i in range(9):
-            p.set(5401 + i, offset[i])
-        p.set(5410, entry.diameter if entry is not None else 0.0)
-        p.set(5411, entry.frontangle if entry is not None else 0.0)
-        p.set(5412, entry.backangle if entry is not None else 0.0)
-        p.set(5413, entry.orientation if entry is not None else 0.0)
+            p.set(5401 + i, offset[i], internal=True)
+        p.set(5410, entry.diameter if entry is not None else 0.0,
+              internal=True)
+        p.set(5411, entry.frontangle if entry is not None else 0.0,
+              internal=True)
+        p.set(5412, entry.backangle if entry is not None else 0.0,
+              internal=True)
+        p.set(5413, entry.orientation if entry is not None else 0.0,
+              internal=True)
 
     def _tool_number(self, block: Block, letter: str) -> int:
         value = block.words[letter]

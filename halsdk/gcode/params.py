@@ -21,6 +21,10 @@ PERSISTENT: tuple[int, ...] = tuple(
 #: values the interpreter answers through :meth:`Parameters.set_predefined`.
 POSITION = range(5420, 5429)
 
+#: The tool in the spindle (#5400 number, #5401.. offsets, diameter,
+#: angles, orientation): set by the interpreter, read-only for programs.
+READ_ONLY = range(5400, 5414)
+
 #: Numbered parameters local to a subroutine call (its arguments).
 LOCAL_NUMBERED = range(1, 31)
 
@@ -137,8 +141,12 @@ class Parameters:
                 return float(value)
         return self._numbered.get(number, 0.0)
 
-    def set(self, key: Key, value: float) -> None:
-        """Store ``value`` in parameter ``key`` (in the current scope)."""
+    def set(self, key: Key, value: float, *, internal: bool = False) -> None:
+        """Store ``value`` in parameter ``key`` (in the current scope).
+
+        The tool parameters #5400..#5413 and the position #5420..#5428
+        are read-only for programs, as in the reference; the interpreter
+        sets the tool ones with ``internal=True``."""
         value = float(value)
         if isinstance(key, str):
             name = normalize_name(key)
@@ -152,6 +160,8 @@ class Parameters:
                 self._frames[-1].named[name] = value
             return
         number = self._number(key)
+        if not internal and (number in READ_ONLY or number in POSITION):
+            raise GCodeError(f"parameter #{number} is read-only")
         if number in LOCAL_NUMBERED and self.depth:
             self._frames[-1].numbered[number] = value
         else:

@@ -692,3 +692,10 @@ def test_ini_named_parameters_read_the_ini_upper_case():
     with pytest.raises(GCodeError, match="read-only"):
         interp.run(Program("#<_ini[axis_x]max_limit> = 1\n",
                            params=interp.params))
+
+
+def test_tool_and_position_parameters_are_read_only():
+    for number in (5400, 5413, 5420, 5428):
+        assert "read-only" in str(err(f"#{number} = 1\n"))
+    interp, _ = run("#5399 = 2\n#5429 = 3\nT1 M6\n")
+    assert interp.params.get(5429) == 3 and interp.params.get(5400) == 1
