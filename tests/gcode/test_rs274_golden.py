@@ -165,3 +165,33 @@ def test_positions_print_as_programmed(moves: list, units: str,
     want = [f"STRAIGHT_TRAVERSE({float(x):.4f}, {float(y):.4f}, "
             f"{float(z):.4f}, 0.0000, 0.0000, 0.0000)" for x, y, z in moves]
     assert [normalise(g) for g in got] == [normalise(w) for w in want]
+
+
+_CODES = ["G0", "G1", "G2", "G3", "G4", "G5", "G5.1", "G7", "G8", "G10 L2",
+          "G10 L20", "G10 L1", "G17", "G18", "G19", "G20", "G21", "G28",
+          "G30", "G33", "G38.2", "G40", "G41", "G42", "G43", "G43.1",
+          "G43.2", "G49", "G53", "G54", "G55", "G59.3", "G61", "G64", "G73",
+          "G76", "G80", "G81", "G82", "G83", "G84", "G85", "G86", "G87",
+          "G88", "G89", "G90", "G91", "G90.1", "G91.1", "G92", "G92.1",
+          "G93", "G94", "G95", "G98", "G99", "M0", "M3", "M4", "M5", "M6",
+          "M7", "M8", "M9", "M19", "M48", "M50", "M61", "M62", "M66",
+          "M70", "M72", "M73"]
+_word = st.tuples(st.sampled_from("XYZABCIJKRPQDHLEFST"),
+                  st.integers(-20, 20)).map(lambda w: f"{w[0]}{w[1] / 2:g}")
+_line = st.tuples(st.lists(st.sampled_from(_CODES), max_size=2),
+                  st.lists(_word, max_size=5)).map(
+                      lambda t: " ".join(t[0] + t[1]))
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.lists(_line, min_size=1, max_size=8))
+def test_any_program_ends_with_a_status_not_a_crash(lines: list) -> None:
+    """Random lines of codes and words: rs274 reports an error or runs
+    to the end, never raises (fail safe, no traceback)."""
+    out, err = io.StringIO(), io.StringIO()
+    status = run("\n".join(lines + ["M2"]) + "\n", "fuzz.ngc", out.write,
+                 err.write)
+    assert status in (0, 1)
+    assert out.getvalue().endswith("ON_RESET()\n")
+    if status:
+        assert err.getvalue().startswith("fuzz.ngc:")
