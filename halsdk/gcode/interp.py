@@ -607,10 +607,16 @@ class Interpreter:
         axes = self._axis_words(block)
         g0 = gs.get(0)
         user0 = g0 in AXIS_USERS_GROUP0
-        if g0 in AXIS_USERS_GROUP0 and gs.get(1, 800) != 800 and axes:
+        if g0 in AXIS_USERS_GROUP0 and gs.get(1, 800) != 800:
+            # (even without axis words, as the reference)
             raise block.error(
                 f"G{g0 / 10:g} and G{gs[1] / 10:g} both use the axis words",
                 code_key("g", gs[1] / 10))
+        if 1 in gs and gs[1] not in (0, 10, 800, 382, 383, 384, 385) \
+                and not axes:
+            raise block.error(f"all axes missing with motion code "
+                              f"G{gs[1] / 10:g}", code_key("g", gs[1] / 10))
+
         if g0 == 530 and gs.get(1, self.modal.motion) not in (0, 10):
             raise block.error("G53 needs G0 or G1", "g53")
         if g0 == 530 and gs.get(3, self.modal.distance) == 910:
@@ -634,8 +640,10 @@ class Interpreter:
         moving = (motion != 800 and g0 not in AXIS_USERS_GROUP0
                   and gs.get(8) != 431
                   and (1 in gs or bool(self._axis_words(block))))
-        if moving and motion in (20, 30):
+        if motion in (20, 30) and g0 not in AXIS_USERS_GROUP0:
+            # (the modal arc takes them even on a line without axes)
             allowed |= set("ijkrp")
+
         elif moving and motion == 330:
             allowed.add("k")
         elif moving and motion == 760:
@@ -990,6 +998,11 @@ class Interpreter:
             return
         if level not in (2, 20):
             raise block.error(f"G10 L{level:g} is not supported", "l")
+        if "i" in block.words or "j" in block.words:
+            raise block.error("I and J words are not allowed with G10 "
+                              f"L{level:g}", "g10")
+        if level == 20 and "r" in block.words:
+            raise block.error("R is not allowed with G10 L20", "r")
         p = self._index(block, "p", "G10 L2/L20")
         if p > 9:
             raise block.error(f"G10 P{p}: coordinate systems are 0..9", "p")
@@ -1103,7 +1116,10 @@ class Interpreter:
         if gs.get(0) in AXIS_USERS_GROUP0 or gs.get(8) == 431:
             return
         motion = self.modal.motion
-        if motion == 800 or not (has_axes or explicit is not None):
+        # a centre word alone repeats a modal arc (to where the tool is:
+        # a full circle), as in the reference
+        centre = motion in (20, 30) and any(w in block.words for w in "ijk")
+        if motion == 800 or not (has_axes or explicit is not None or centre):
             return
         line = block.line
         key = code_key("g", motion / 10)
@@ -1325,6 +1341,11 @@ class Interpreter:
     def _arc(self, block: Block, motion: int) -> None:
         key = code_key("g", motion / 10)
         a1, a2, _normal, centre_words = PLANES[self.modal.plane]
+        other = {170: "k", 180: "j", 190: "i"}[self.modal.plane]
+        if other in block.words and "r" not in block.words:
+            raise block.error(f"{other.upper()} word given for an arc in the "
+                              f"{ {'k': 'XY', 'j': 'XZ', 'i': 'YZ'}[other]} "
+                              "plane", other)
         if self.rotation and self.modal.plane != 170:
             raise block.error("arcs outside G17 in a rotated coordinate "
                               "system (G10 L2 R) are not supported", key)

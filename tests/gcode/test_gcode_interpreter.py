@@ -179,7 +179,9 @@ def test_arc_errors():
     assert "both missing" in str(err("F1 G2 Z1 R1\n"))
     assert "both missing" in str(err("F1 G2 X1\n"))
     assert "need both" in str(err("F1 G90.1 G2 X1 I1\n"))
-    assert "P (turns)" in str(err("G0 X1\nF1 G2 I-1 P0.5\n"))
+    assert "P (turns)" in str(err("G0 X1\nF1 G2 X1 I-1 P0.5\n"))
+    # as in the reference, an arc or a cycle needs an axis word
+    assert "all axes missing" in str(err("G0 X1\nF1 G2 I-1\n"))
 
 
 def test_absolute_arc_centre_g90_1():
@@ -468,8 +470,10 @@ def test_g84_g88_retract_modes_and_repeats():
 def test_g84_g88_errors():
     e = err("S100 M3 F10\nG84 Z-1\n")
     assert (e.line, e.column) == (2, 1) and "needs the word R" in str(e)
-    e = err("S100 M3 F10\nG88 R1\n")
+    e = err("S100 M3 F10\nG88 X1 R1\n")
     assert (e.line, e.column) == (2, 1) and "needs the word Z" in str(e)
+    e = err("S100 M3 F10\nG88 R1\n")
+    assert (e.line, e.column) == (2, 1) and "all axes missing" in str(e)
     e = err("S100 M4 F10\n G84 R1 Z-1\n")
     assert (e.line, e.column) == (2, 2) and "clockwise" in str(e)
     e = err("F10\nG88 R1 Z-1\n")
