@@ -612,8 +612,7 @@ class Interpreter:
             raise block.error(
                 f"G{g0 / 10:g} and G{gs[1] / 10:g} both use the axis words",
                 code_key("g", gs[1] / 10))
-        if 1 in gs and gs[1] not in (0, 10, 800, 382, 383, 384, 385) \
-                and not axes:
+        if 1 in gs and (gs[1] in CANNED or gs[1] == 870) and not axes:
             raise block.error(f"all axes missing with motion code "
                               f"G{gs[1] / 10:g}", code_key("g", gs[1] / 10))
 
@@ -1342,6 +1341,16 @@ class Interpreter:
         key = code_key("g", motion / 10)
         a1, a2, _normal, centre_words = PLANES[self.modal.plane]
         other = {170: "k", 180: "j", 190: "i"}[self.modal.plane]
+        words = block.words
+        if "r" in words and any(w in words for w in "ijk"):
+            raise block.error("mixed radius and IJK format for an arc", "r")
+        if not ("r" in words or any(w in words for w in "ijk")):
+            raise block.error("R, I, J and K words all missing for an arc",
+                              key)
+        explicit = any(round(g * 10) == motion for g in block.g)
+        if explicit and not self._axis_words(block):
+            raise block.error(f"all axes missing with motion code "
+                              f"G{motion / 10:g}", key)
         if other in block.words and "r" not in block.words:
             raise block.error(f"{other.upper()} word given for an arc in the "
                               f"{ {'k': 'XY', 'j': 'XZ', 'i': 'YZ'}[other]} "

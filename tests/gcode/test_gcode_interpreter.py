@@ -177,7 +177,7 @@ def test_arc_errors():
     assert "too small" in str(err("F1 G2 X10 R2\n"))
     assert "full circle" in str(err("F1 G2 X0 Y0 R2\n"))
     assert "both missing" in str(err("F1 G2 Z1 R1\n"))
-    assert "both missing" in str(err("F1 G2 X1\n"))
+    assert "all missing" in str(err("F1 G2 X1\n"))
     assert "need both" in str(err("F1 G90.1 G2 X1 I1\n"))
     assert "P (turns)" in str(err("G0 X1\nF1 G2 X1 I-1 P0.5\n"))
     # as in the reference, an arc or a cycle needs an axis word
