@@ -417,7 +417,7 @@ class Interpreter:
                                   code_key("g", g0 / 10))
             self._go_home(block, g0)
         elif g0 in (281, 301):
-            home = self.pos_without_tlo()
+            home = list(self.pos)       # the machine position, as stored
             base = 5161 if g0 == 281 else 5181
             for i in range(9):
                 self.params.set(base + i, home[i])
@@ -612,7 +612,13 @@ class Interpreter:
             raise block.error(
                 f"G{g0 / 10:g} and G{gs[1] / 10:g} both use the axis words",
                 code_key("g", gs[1] / 10))
-        if 1 in gs and (gs[1] in CANNED or gs[1] == 870) and not axes:
+        if gs.get(1) == 760:        # G76 is checked before the line runs
+            for letter in "pzijk":
+                if letter not in block.words:
+                    raise block.error(f"G76 needs the word {letter.upper()}",
+                                      "g76")
+        if 1 in gs and not axes and (gs[1] in CANNED or gs[1] in (
+                870, 330, 382, 383, 384, 385, 50, 51)):
             raise block.error(f"all axes missing with motion code "
                               f"G{gs[1] / 10:g}", code_key("g", gs[1] / 10))
 
@@ -626,8 +632,11 @@ class Interpreter:
         if axes and not user0 and gs.get(8) != 431 and motion == 800:
             raise block.error(
                 f"{axes[0].upper()} word with no G code to use it", axes[0])
+        users = self._word_users(block, gs, ms, motion)
         for letter in block.words:
-            if letter not in self._word_users(block, gs, ms, motion):
+            if letter == "q" and self.ref and block.words["q"] == -1.0:
+                continue            # the reference's "no Q" value
+            if letter not in users:
                 raise block.error(f"{letter.upper()} word with no G or M "
                                   "code to use it", letter)
 
@@ -1054,7 +1063,9 @@ class Interpreter:
     def _go_home(self, block: Block, code: int) -> None:
         line = block.line
         base = 5161 if code == 280 else 5181
-        home = [self.params.get(base + i) + self.tlo[i] for i in range(9)]
+        # the stored point is where the machine goes (the tool length
+        # offset is not added), as in the reference
+        home = [self.params.get(base + i) for i in range(9)]
         axes = self._axis_words(block)
         if axes or self.ref:
             middle = self._target(block)
@@ -1347,10 +1358,6 @@ class Interpreter:
         if not ("r" in words or any(w in words for w in "ijk")):
             raise block.error("R, I, J and K words all missing for an arc",
                               key)
-        explicit = any(round(g * 10) == motion for g in block.g)
-        if explicit and not self._axis_words(block):
-            raise block.error(f"all axes missing with motion code "
-                              f"G{motion / 10:g}", key)
         if other in block.words and "r" not in block.words:
             raise block.error(f"{other.upper()} word given for an arc in the "
                               f"{ {'k': 'XY', 'j': 'XZ', 'i': 'YZ'}[other]} "

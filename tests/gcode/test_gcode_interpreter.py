@@ -181,7 +181,7 @@ def test_arc_errors():
     assert "need both" in str(err("F1 G90.1 G2 X1 I1\n"))
     assert "P (turns)" in str(err("G0 X1\nF1 G2 X1 I-1 P0.5\n"))
     # as in the reference, an arc or a cycle needs an axis word
-    assert "all axes missing" in str(err("G0 X1\nF1 G2 I-1\n"))
+    assert "all axes missing" in str(err("G0 X1\nF1 G38.2\n"))
 
 
 def test_absolute_arc_centre_g90_1():
