@@ -612,6 +612,8 @@ class Interpreter:
             raise block.error(
                 f"G{g0 / 10:g} and G{gs[1] / 10:g} both use the axis words",
                 code_key("g", gs[1] / 10))
+        if gs.get(1) == 330 and "k" not in block.words:
+            raise block.error("G33 needs a positive K word", "g33")
         if gs.get(1) == 760:        # G76 is checked before the line runs
             for letter in "pzijk":
                 if letter not in block.words:
@@ -656,8 +658,10 @@ class Interpreter:
             allowed.add("k")
         elif moving and motion == 760:
             allowed |= set("pijkrqhel")
-        elif moving and motion in (50, 51):
+        elif moving and motion == 50:
             allowed |= set("ijpq")
+        elif moving and motion == 51:
+            allowed |= set("ij")
         elif moving and (motion in CANNED or motion in UNSUPPORTED_MOTION):
             allowed |= set("rlpq")
             if motion == 870:
