@@ -319,6 +319,7 @@ cdef double _PI = math.pi
 #: words)
 PLANES = {170: (0, 1, 2, "ij"), 180: (2, 0, 1, "ki"), 190: (1, 2, 0, "jk")}
 cdef dict _PLANES = PLANES
+cdef dict _OTHER_CENTRE = {170: "k", 180: "j", 190: "i"}
 
 
 cdef double _factor(object interp, object modal):
@@ -456,6 +457,11 @@ cdef bint _arc(object interp, object block, dict words, object modal,
         return False
     a1, a2, _, centre = _PLANES[modal.plane]
     w1, w2 = centre[0], centre[1]
+    # the errors of missing centre words, or of the third one, are
+    # Interpreter._arc's
+    if (w1 not in words and w2 not in words) or \
+            _OTHER_CENTRE[modal.plane] in words:
+        return False
     start = interp.pos
     end = _target(interp, words, modal)
     s1, s2, e1, e2 = start[a1], start[a2], end[a1], end[a2]

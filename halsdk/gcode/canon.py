@@ -275,3 +275,19 @@ class RecordingCanon(Canon):
     def of_type(self, *types: type) -> list[Command]:
         """The recorded commands that are instances of ``types``."""
         return [c for c in self.commands if isinstance(c, types)]
+
+
+@dataclass(frozen=True)
+class Trace(Command):
+    """A call of the reference's standalone interpreter that has no
+    machine meaning (``COMMENT(...)``, ``START_CHANGE()``,
+    ``SET_FEED_MODE(0, 0)`` ...), already in its text form.
+
+    Emitted only to canons whose ``reference_calls`` attribute is true
+    (:class:`halsdk.gcode.canon_text.TextCanon`); ``kind`` is 'call' for a
+    numbered canonical call and 'print' for text printed as is
+    (``(PRINT, ...)`` comments).
+    """
+    text: str
+    kind: str = "call"
+    line: int = 0

@@ -14,19 +14,22 @@ Conventions
   the way the developer manual's tool section describes, and the matching
   canon commands let the machine layer update its copy.
 * Cutter radius compensation (G41/G42 with D = tool number, radius from
-  the tool table) covers straight moves in G17; see cutter_radius for what
-  is refused.
+  the tool table) covers lines and arcs in G17 and G18; see cutter_radius
+  for what is refused.
 * G84 is the floating-chuck tap of the reference manual: feed in, spindle
   reversed for a feed out at the same rate, no spindle synchronisation;
   it needs the spindle on clockwise (M3).  G88 feeds in, dwells, stops the
   spindle and pauses the program so the operator can withdraw the tool by
   hand, then restarts the spindle; it needs the spindle on.
-* Not supported (clear error): G76, G87, G10 L2/L20 rotation (R).
+* G10 L2/L20 R rotates the coordinate system in XY about its origin.
+* G76 threads: passes of growing depth, each a spindle-synchronised feed.
+* Not supported (clear error): G87.
 """
 
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import replace
 from typing import Any, Callable, Optional
 
@@ -36,6 +39,39 @@ from .block import Block, code_key
 from .cutter_radius import CutterComp, CutterRadiusError
 from .modal import AXIS_USERS_GROUP0, ModalState, group_codes
 
+_DEBUG_PARAM = re.compile(r"#\s*<([^>]*)>|#\s*(\d+)")
+
+
+def last_comment(text: str) -> Optional[tuple[str, str]]:
+    """The last ``( )`` comment of a line as ``(kind, text)``: kind is
+    'msg', 'debug', 'print', 'log', 'logopen', 'logappend', 'logclose'
+    or '' (plain); the text after the comma is kept as written.  ``;``
+    ends the scan (the reference does not report ``;`` comments)."""
+    found: Optional[tuple[str, str]] = None
+    i = 0
+    while i < len(text):
+        char = text[i]
+        if char == ";":
+            break
+        if char == "(":
+            end = text.find(")", i + 1)
+            if end < 0:
+                break
+            body = text[i + 1:end]
+            head, comma, rest = body.partition(",")
+            kind = "".join(head.split()).lower()
+            if comma and kind in ("msg", "debug", "print", "log",
+                                  "logopen", "logappend"):
+                found = (kind, rest)
+            elif kind == "logclose":
+                found = (kind, "")
+            else:
+                found = ("", body)
+            i = end + 1
+            continue
+        i += 1
+    return found
+
 AXES = "xyzabcuvw"
 ROTARY = (3, 4, 5)
 ZERO9: C.Pose = (0.0,) * 9
@@ -43,8 +79,28 @@ ZERO9: C.Pose = (0.0,) * 9
 PLANES = {170: (0, 1, 2, "ij"), 180: (2, 0, 1, "ki"), 190: (1, 2, 0, "jk")}
 COORD_CODES = (540, 550, 560, 570, 580, 590, 591, 592, 593)
 CANNED = (730, 810, 820, 830, 840, 850, 860, 880, 890)
-UNSUPPORTED_MOTION = {760: "G76", 870: "G87"}
+UNSUPPORTED_MOTION = {870: "G87"}
 
+
+def _rotate(x: float, y: float, degrees: float) -> tuple[float, float]:
+    """(x, y) turned counter-clockwise by ``degrees``."""
+    t = math.radians(degrees)
+    c, s = math.cos(t), math.sin(t)
+    return x * c - y * s, x * s + y * c
+
+
+def _bezier(points: list[tuple[float, float]], t: float
+            ) -> tuple[float, float]:
+    """The point at ``t`` of the Bezier curve of ``points`` (de Casteljau)."""
+    pts = list(points)
+    while len(pts) > 1:
+        pts = [((1 - t) * a[0] + t * b[0], (1 - t) * a[1] + t * b[1])
+               for a, b in zip(pts, pts[1:])]
+    return pts[0]
+
+
+#: The axis letters, as a set.
+AXIS_SET = frozenset(AXES)
 
 #: Letters every block may hold (the others need a code that uses them).
 ALWAYS_ALLOWED = frozenset(AXES + "fstno")
@@ -58,15 +114,29 @@ class Interpreter:
     """Executes :class:`~halsdk.gcode.block.Block` objects one at a time."""
 
     def __init__(self, params: Any, tools: Any, canon: C.Canon, *,
-                 random_toolchanger: bool = False, units: str = "mm") -> None:
-        if units not in ("mm", "inch"):
-            raise ValueError(f"units must be 'mm' or 'inch', not {units!r}")
+                 random_toolchanger: bool = False, units: str = "mm",
+                 program_units: Optional[str] = None,
+                 ini: Optional[Callable[[str, str], Optional[str]]] = None
+                 ) -> None:
+        program_units = program_units or units
+        for value in (units, program_units):
+            if value not in ("mm", "inch"):
+                raise ValueError(
+                    f"units must be 'mm' or 'inch', not {value!r}")
         self.params = params
         self.tools = tools
         self.canon = canon
+        #: ``ini(SECTION, KEY)``: the INI value behind ``#<_ini[s]k>``
+        self.ini = ini
+        #: emit the reference's informational calls (COMMENT, START_CHANGE
+        #: ...) as Trace commands: only for canons that ask for them
+        self.ref = bool(getattr(canon, "reference_calls", False))
         self.random = random_toolchanger
         self.machine_metric = units == "mm"
-        self.modal = ModalState(units=210 if self.machine_metric else 200)
+        self.modal = ModalState(units=210 if program_units == "mm" else 200)
+        if self.ref:
+            self.modal.retract = 990    # the reference starts in G99
+            self.modal.motion = 800     # and in G80
         self.pos = [0.0] * 9
         self.tlo = [0.0] * 9
         self.g92 = [0.0] * 9
@@ -76,6 +146,8 @@ class Interpreter:
         self.modal.coord_system = COORD_CODES[min(max(index, 1), 9) - 1]
         self.params.set(5220, index)
         self.feed = 0.0
+        #: the last F number as written (the feed in program units)
+        self.feed_value = 0.0
         self.speed = 0.0
         self.current_tool = -1 if self.random else 0
         spindle = getattr(tools, "spindle", None)
@@ -83,6 +155,17 @@ class Interpreter:
             self.current_tool = int(spindle.tool)
         self.selected_tool = -1
         self.selected_pocket = -1
+        self.diameter_mode = False
+        self._previous_motion = 10
+        self._sync: Optional[float] = None      # G76: pitch being synced
+        self._spline_pq = (0.0, 0.0)            # G5: the last P, Q
+        #: the program being run (for M73: its call level)
+        self.program: Any = None
+        #: M70 state and the M73 state with its call level
+        self._saved: Optional[dict[str, Any]] = None
+        self._autosaved: list[tuple[int, dict[str, Any]]] = []
+        self.cycle_il: Optional[float] = None
+        self.blend: tuple[Optional[float], Optional[float]] = (None, None)
         self.cycle: dict[str, float] = {}
         self.line = 0
         self.ended = False
@@ -112,16 +195,37 @@ class Interpreter:
         base = 5201 + 20 * (index or self.coord_index)
         return self.params.numbered(base, 9)
 
-    def program_position(self) -> list[float]:
-        """Current position in program coordinates, machine units."""
+    @property
+    def rotation(self) -> float:
+        """The XY rotation of the active coordinate system (degrees,
+        G10 L2 R): its parameter follows the nine offsets."""
+        return float(self.params.get(5210 + 20 * self.coord_index))
+
+    def _unrotated(self, machine: list[float]) -> list[float]:
+        """``machine`` less the G5x offset and the TLO, turned back by the
+        rotation: G92-shifted program coordinates."""
         g5x = self._g5x()
-        return [self.pos[i] - g5x[i] - self.g92[i] - self.tlo[i]
-                for i in range(9)]
+        d = [machine[i] - g5x[i] - self.tlo[i] for i in range(9)]
+        angle = self.rotation
+        if angle:
+            d[0], d[1] = _rotate(d[0], d[1], -angle)
+        return d
+
+    def program_position(self) -> list[float]:
+        """Current position in program coordinates, machine units.
+
+        program = rotate(machine - G5x - TLO, -R) - G92: the reference's
+        order (the rotation turns about the G5x origin)."""
+        d = self._unrotated(self.pos)
+        return [d[i] - self.g92[i] for i in range(9)]
 
     def _to_machine(self, prog: list[float]) -> list[float]:
         g5x = self._g5x()
-        return [prog[i] + g5x[i] + self.g92[i] + self.tlo[i]
-                for i in range(9)]
+        v = [prog[i] + self.g92[i] for i in range(9)]
+        angle = self.rotation
+        if angle:
+            v[0], v[1] = _rotate(v[0], v[1], angle)
+        return [v[i] + g5x[i] + self.tlo[i] for i in range(9)]
 
     def _axis_words(self, block: Block) -> list[str]:
         return [a for a in AXES if a in block.words]
@@ -134,26 +238,72 @@ class Interpreter:
                 if a in block.words:
                     end[i] = block.words[a] * self._k(i) + self.tlo[i]
             return end
-        # program_position() and _to_machine() with one reading of the
-        # offsets (the same arithmetic)
-        g5x, g92, tlo, pos = self._g5x(), self.g92, self.tlo, self.pos
-        prog = [pos[i] - g5x[i] - g92[i] - tlo[i] for i in range(9)]
+        angle = self.rotation
+        if angle:
+            prog = self.program_position()
+        else:
+            # program_position() and _to_machine() with one reading of
+            # the offsets (the same arithmetic, no rotation)
+            g5x, g92, tlo, pos = self._g5x(), self.g92, self.tlo, self.pos
+            prog = [pos[i] - g5x[i] - g92[i] - tlo[i] for i in range(9)]
         incremental = self.modal.distance == 910
         words = block.words
         k = self._k()
+        diameter = self.diameter_mode
         for i, a in enumerate(AXES):
             if a in words:
                 value = words[a] * (1.0 if i in ROTARY else k)
+                if i == 0 and diameter:
+                    value /= 2      # G7: X words are diameters
                 prog[i] = prog[i] + value if incremental else value
+        if angle:
+            return self._to_machine(prog)
         return [prog[i] + g5x[i] + g92[i] + tlo[i] for i in range(9)]
 
     def _emit(self, command: C.Command) -> None:
         if not self.comp.hold(command):
             self.canon.emit(command)
 
+    def _trace(self, text: str, kind: str = "call") -> None:
+        """A reference-only call (see :class:`canon.Trace`)."""
+        if self.ref:
+            self._emit(C.Trace(text, kind, self.line))
+
+    def _comment_trace(self, block: Block) -> None:
+        """The last comment of the line, as the reference reports it."""
+        found = last_comment(block.text)
+        if found is None:
+            return
+        kind, text = found
+        if kind == "":
+            self._trace(f'COMMENT("{text}")')
+        elif kind == "msg":
+            self._trace(f'MESSAGE("{text}")')
+        elif kind == "debug":
+            self._trace(f'MESSAGE("{self._substitute(text)}")')
+        elif kind == "print":
+            self._trace(self._substitute(text), "print")
+        elif kind == "log":
+            self._trace(f'LOG("{self._substitute(text)}")')
+        elif kind == "logclose":
+            self._trace("LOGCLOSE()")
+        else:                       # logopen, logappend
+            self._trace(f'{kind.upper()}("{text.strip()}")')
+
+    def _substitute(self, text: str) -> str:
+        def one(match: re.Match[str]) -> str:
+            key: Any = (match.group(1) if match.group(1) is not None
+                        else int(match.group(2)))
+            try:
+                return f"{self.params.get(key):.6f}"
+            except Exception:
+                return "######"
+        return _DEBUG_PARAM.sub(one, text)
+
     # -- public API ------------------------------------------------------
     def run(self, program: Any) -> None:
         """Execute every block of ``program`` until it ends."""
+        self.program = program
         for block in program.blocks():
             self.execute(block)
             if self.ended:
@@ -165,9 +315,22 @@ class Interpreter:
         # plain moves (most blocks of a CAM program) take a short path,
         # compiled: it does what this method, _target, _straight_feed and
         # _traverse do for them, so a change to those belongs there too
-        if fast_move(self, block):
+        if self._fast_ready(block) and fast_move(self, block):
             return
         self._execute(block)
+
+    def _fast_ready(self, block: Block) -> bool:
+        """Whether the state lets the short path take ``block``: it knows
+        neither G7 diameters, nor a rotated coordinate system, nor the
+        M73 restore, nor the feed's bookkeeping (an F word: rare on the
+        lines of a CAM program), nor the reference's extra calls of
+        ``rs274``."""
+        if self.diameter_mode or self._autosaved or "f" in block.words:
+            return False
+        if self.ref and (block.comments or self.modal.feed_mode == 930
+                         or AXIS_SET.isdisjoint(block.words)):
+            return False
+        return not self.params.get(5210 + 20 * self.coord_index)
 
     def _execute(self, block: Block) -> None:
         """:meth:`execute` without the short path of plain moves."""
@@ -176,65 +339,117 @@ class Interpreter:
         gs, ms = group_codes(block)
         self._check(block, gs, ms)
         line = block.line
-        if block.message:
+        ref = self.ref
+        self._auto_restore(block)
+        if ref:
+            self._comment_trace(block)
+        elif block.message:
             self._emit(C.Message(block.message, line))
         if 5 in gs:
-            self.modal.feed_mode = gs[5]
-            self._emit(C.SetFeedMode(
-                "inverse_time" if gs[5] == 930 else "units_per_minute", line))
-        if "f" in block.words and self.modal.feed_mode == 940:
+            self._feed_mode(block, gs[5])
+        if "f" in block.words:
             f = block.words["f"]
             if f < 0:
                 raise block.error("negative feed rate", "f")
-            self.feed = self._len(f)
-            self._emit(C.SetFeedRate(self.feed, line))
+            self.feed_value = f
+            if ref:
+                if self.modal.feed_mode != 930:
+                    self._trace(f"SET_FEED_RATE({f:.4f})")
+                    self.feed = self._len(f)
+            elif self.modal.feed_mode == 940:
+                self.feed = self._len(f)
+                self._emit(C.SetFeedRate(self.feed, line))
         if "s" in block.words:
             s = block.words["s"]
             if s < 0:
                 raise block.error("negative spindle speed", "s")
             self.speed = s
-            self._emit(C.SpindleSpeed(s, line))
+            if ref:
+                self._trace(f"SET_SPINDLE_SPEED(0, {s:.4f})")
+            else:
+                self._emit(C.SpindleSpeed(s, line))
         if "t" in block.words:
             self._select_tool(block)
         if 5 in ms:
             self._hal_io(block, ms[5])
         if 6 in ms:
             self._tool_change(block, ms[6])
-        if 7 in ms:
-            self._spindle(ms[7], line)
+        if 7 in ms:                 # M70-M73 share the spindle's group
+            if ms[7] == 190:
+                self._orient(block)
+            elif ms[7] >= 700:
+                self._modal_state(block, ms[7])
+            else:
+                self._spindle(ms[7], line)
         if 8 in ms:
             code = ms[8]
             self.modal.mist = code == 70 or (self.modal.mist and code != 90)
             self.modal.flood = code == 80 or (self.modal.flood and code != 90)
             self._emit(C.Coolant({70: "mist", 80: "flood", 90: "off"}[code],
                                  line))
+        if 9 in ms:
+            self._overrides(block, ms[9])
         if gs.get(0) == 40:
             p = self._need(block, "p", "G4")
             if p < 0:
                 raise block.error("negative dwell time", "p")
             self._emit(C.Dwell(p, line))
         if 2 in gs:
+            if self.comp.active and gs[2] != self.modal.plane:
+                raise block.error("cannot change the plane with cutter "
+                                  "compensation on",
+                                  code_key("g", gs[2] / 10))
             self.modal.plane = gs[2]
             self._emit(C.SetPlane(gs[2] // 10, line))
         if 6 in gs:
             self.modal.units = gs[6]
+            self._trace("USE_LENGTH_UNITS(CANON_UNITS_"
+                        f"{'MM' if gs[6] == 210 else 'INCHES'})")
         if 7 in gs:
             self._cutter_comp(block, gs[7])
         if 8 in gs:
             self._tool_length(block, gs[8])
         if 12 in gs:
-            self.modal.coord_system = gs[12]
-            self.params.set(5220, self.coord_index)
-            self._emit(C.SetG5xOffset(self.coord_index, _pose(self._g5x()),
-                                      line))
+            if ref and gs[12] == self.modal.coord_system:
+                self._trace('COMMENT("interpreter: continuing to use same '
+                            'coordinate system")')
+            else:
+                self.modal.coord_system = gs[12]
+                self.params.set(5220, self.coord_index)
+                self._emit(C.SetG5xOffset(self.coord_index,
+                                          _pose(self._g5x()), line))
+                if ref:
+                    self._emit(C.SetG92Offset(_pose(self.g92), line))
+                    self._trace(f"SET_XY_ROTATION({self.rotation:.4f})")
         if 13 in gs:
             self._control(block, gs[13])
         if 3 in gs:
+            if gs[3] != self.modal.distance:
+                self._trace('COMMENT("interpreter: distance mode changed to '
+                            f'{"absolute" if gs[3] == 900 else "incremental"}'
+                            '")')
             self.modal.distance = gs[3]
         if 4 in gs:
+            if gs[4] != self.modal.arc_distance:
+                self._trace('COMMENT("interpreter: IJK distance mode changed '
+                            f'to {"absolute" if gs[4] == 901 else "incremental"}'
+                            '")')
             self.modal.arc_distance = gs[4]
         if 10 in gs:
             self.modal.retract = gs[10]
+            self._trace('COMMENT("interpreter: retract mode set to '
+                        f'{"old_z" if gs[10] == 980 else "r_plane"}")')
+        if 15 in gs:
+            if not ref:
+                raise block.error(f"G{gs[15] // 10} (lathe diameter/radius "
+                                  "mode) is not supported",
+                                  code_key("g", gs[15] / 10))
+            diameter = gs[15] == 70
+            if diameter != self.diameter_mode:
+                self._trace('COMMENT("interpreter: Lathe diameter mode '
+                            f'changed to {"diameter" if diameter else "radius"}'
+                            '")')
+            self.diameter_mode = diameter
         g0 = gs.get(0)
         if g0 in (100,):
             self._g10(block)
@@ -244,7 +459,7 @@ class Interpreter:
                                   code_key("g", g0 / 10))
             self._go_home(block, g0)
         elif g0 in (281, 301):
-            home = self.pos_without_tlo()
+            home = list(self.pos)       # the machine position, as stored
             base = 5161 if g0 == 281 else 5181
             for i in range(9):
                 self.params.set(base + i, home[i])
@@ -253,6 +468,159 @@ class Interpreter:
         self._motion(block, gs)
         if 4 in ms:
             self._stop(ms[4], line)
+
+    # -- M70-M73: saving and restoring the modal state --------------------
+    def _state(self) -> dict[str, Any]:
+        m = self.modal
+        return {"units": m.units, "plane": m.plane, "distance": m.distance,
+                "arc_distance": m.arc_distance, "feed_mode": m.feed_mode,
+                "feed": self.feed, "feed_value": self.feed_value,
+                "speed": self.speed,
+                "spindle": m.spindle, "mist": m.mist, "flood": m.flood,
+                "coord_system": m.coord_system, "control": m.control,
+                "blend": self.blend, "retract": m.retract,
+                "diameter": self.diameter_mode}
+
+    def _modal_state(self, block: Block, code: int) -> None:
+        if code == 700:
+            self._saved = self._state()
+        elif code == 710:
+            self._saved = None
+        elif code == 720:
+            if self._saved is None:
+                raise block.error("M72 without a state saved by M70",
+                                  "m72")
+            self._restore(self._saved, block.line)
+        else:
+            # in the main program (level 0) it is never restored
+            level = getattr(self.program, "call_level", 0)
+            self._autosaved.append((level, self._state()))
+
+    def _auto_restore(self, block: Block) -> None:
+        """M73: the state comes back when its subroutine has returned."""
+        level = getattr(self.program, "call_level", 0)
+        while self._autosaved and self._autosaved[-1][0] > level:
+            _, state = self._autosaved.pop()
+            self._restore(state, block.line)
+
+    def _restore(self, state: dict[str, Any], line: int) -> None:
+        """Bring back a saved modal state, in the reference's order, with
+        a call for each setting that changed."""
+        m = self.modal
+        if state["units"] != m.units:
+            m.units = state["units"]
+            self._trace("USE_LENGTH_UNITS(CANON_UNITS_"
+                        f"{'MM' if m.units == 210 else 'INCHES'})")
+        if state["feed_mode"] != m.feed_mode:
+            self._feed_mode_calls(state["feed_mode"], line)
+        elif state["feed"] != self.feed:
+            if self.ref:
+                self._trace(f"SET_FEED_RATE({state['feed_value']:.4f})")
+            else:
+                self._emit(C.SetFeedRate(state["feed"], line))
+        self.feed, self.feed_value = state["feed"], state["feed_value"]
+        if state["speed"] != self.speed:
+            self.speed = state["speed"]
+            if self.ref:
+                self._trace(f"SET_SPINDLE_SPEED(0, {self.speed:.4f})")
+            else:
+                self._emit(C.SpindleSpeed(self.speed, line))
+        if state["spindle"] != m.spindle:
+            self._spindle(state["spindle"], line)
+        # coolant as one M code (flood counts before mist), as the
+        # reference compares it
+        def coolant(mist: bool, flood: bool) -> str:
+            return "flood" if flood else "mist" if mist else "off"
+        saved = coolant(state["mist"], state["flood"])
+        if saved != coolant(m.mist, m.flood):
+            self._emit(C.Coolant(saved, line))
+            m.mist, m.flood = saved == "mist", saved == "flood"
+        if state["plane"] != m.plane:
+            m.plane = state["plane"]
+            self._emit(C.SetPlane(m.plane // 10, line))
+        if state["coord_system"] != m.coord_system:
+            m.coord_system = state["coord_system"]
+            self.params.set(5220, self.coord_index)
+            self._emit(C.SetG5xOffset(self.coord_index, _pose(self._g5x()),
+                                      line))
+            if self.ref:
+                self._emit(C.SetG92Offset(_pose(self.g92), line))
+                self._trace(f"SET_XY_ROTATION({self.rotation:.4f})")
+        if (state["control"], state["blend"]) != (m.control, self.blend):
+            m.control, self.blend = state["control"], state["blend"]
+            mode = {610: "exact_path", 611: "exact_stop"}.get(m.control,
+                                                              "blend")
+            self._emit(C.SetTermCond(mode, self.blend[0], self.blend[1],
+                                     line))
+        if state["distance"] != m.distance:
+            m.distance = state["distance"]
+            self._trace('COMMENT("interpreter: distance mode changed to '
+                        f'{"absolute" if m.distance == 900 else "incremental"}'
+                        '")')
+        if state["retract"] != m.retract:
+            m.retract = state["retract"]
+            self._trace('COMMENT("interpreter: retract mode set to '
+                        f'{"old_z" if m.retract == 980 else "r_plane"}")')
+        if state["arc_distance"] != m.arc_distance:
+            m.arc_distance = state["arc_distance"]
+            self._trace('COMMENT("interpreter: IJK distance mode changed to '
+                        f'{"absolute" if m.arc_distance == 901 else "incremental"}'
+                        '")')
+        self.diameter_mode = state["diameter"]
+
+    def _feed_mode(self, block: Block, code: int) -> None:
+        if code == 950 and not self.ref:
+            raise block.error("G95 (feed per revolution) is not supported",
+                              "g95")
+        self._feed_mode_calls(code, block.line)
+
+    def _feed_mode_calls(self, code: int, line: int) -> None:
+        self.modal.feed_mode = code
+        if not self.ref:
+            self._emit(C.SetFeedMode(
+                "inverse_time" if code == 930 else "units_per_minute",
+                line))
+            return
+        what = {930: "inverse time", 940: "units per minute",
+                950: "units per revolution"}[code]
+        self._trace(f'COMMENT("interpreter: feed mode set to {what}")')
+        self._trace(f"SET_FEED_MODE(0, {1 if code == 950 else 0})")
+        if code != 930:
+            self._trace("SET_FEED_RATE(0.0000)")
+            self.feed = self.feed_value = 0.0
+
+    def _orient(self, block: Block) -> None:
+        if not self.ref:
+            raise block.error("M19 (spindle orientation) is not supported",
+                              "m19")
+        words = block.words
+        if not ("r" in words or "q" in words or "p" in words):
+            return
+        r = words.get("r", 0.0)
+        self._trace(f"ORIENT_SPINDLE(0, {r:.4f}, {int(words.get('p', 0))})")
+        if "q" in words:
+            self._trace(f"SPINDLE.0.WAIT_ORIENT_COMPLETE({words['q']:.4f})")
+
+    def _overrides(self, block: Block, code: int) -> None:
+        key = code_key("m", code / 10)
+        if not self.ref:
+            raise block.error(f"M{code // 10} (override control) is not "
+                              "supported", key)
+        on = block.words.get("p", 1.0) != 0
+        if code == 480:
+            self._trace("ENABLE_FEED_OVERRIDE()")
+            self._trace("ENABLE_SPEED_OVERRIDE(0)")
+        elif code == 490:
+            self._trace("DISABLE_FEED_OVERRIDE()")
+            self._trace("DISABLE_SPEED_OVERRIDE(0)")
+        elif code == 500:
+            self._trace(f"{'EN' if on else 'DIS'}ABLE_FEED_OVERRIDE()")
+        elif code == 510:
+            self._trace(f"{'EN' if on else 'DIS'}ABLE_SPEED_OVERRIDE(0)")
+        elif code == 520:
+            self._trace(f"{'EN' if on else 'DIS'}ABLE_ADAPTIVE_FEED()")
+        else:
+            self._trace(f"{'EN' if on else 'DIS'}ABLE_FEED_HOLD()")
 
     def pos_without_tlo(self) -> list[float]:
         return [self.pos[i] - self.tlo[i] for i in range(9)]
@@ -281,13 +649,30 @@ class Interpreter:
         axes = self._axis_words(block)
         g0 = gs.get(0)
         user0 = g0 in AXIS_USERS_GROUP0
-        if g0 in AXIS_USERS_GROUP0 and gs.get(1, 800) != 800 and axes:
+        if g0 in AXIS_USERS_GROUP0 and gs.get(1, 800) != 800:
+            # (even without axis words, as the reference)
             raise block.error(
                 f"G{g0 / 10:g} and G{gs[1] / 10:g} both use the axis words",
                 code_key("g", gs[1] / 10))
+        if gs.get(1) == 330 and "k" not in block.words:
+            raise block.error("G33 needs a positive K word", "g33")
+        if gs.get(1) == 760:        # G76 is checked before the line runs
+            for letter in "pzijk":
+                if letter not in block.words:
+                    raise block.error(f"G76 needs the word {letter.upper()}",
+                                      "g76")
+        if 1 in gs and not axes and (gs[1] in CANNED or gs[1] in (
+                870, 330, 382, 383, 384, 385, 50, 51)):
+            raise block.error(f"all axes missing with motion code "
+                              f"G{gs[1] / 10:g}", code_key("g", gs[1] / 10))
+
         if g0 == 530 and gs.get(1, self.modal.motion) not in (0, 10):
             raise block.error("G53 needs G0 or G1", "g53")
+        if g0 == 530 and gs.get(3, self.modal.distance) == 910:
+            raise block.error("G53 in incremental mode (G91)", "g53")
         motion = gs.get(1, self.modal.motion)
+        if 1 not in gs and motion in (50, 51):
+            motion = 800        # a spline is not repeated by axis words
         if axes and not user0 and gs.get(8) != 431 and motion == 800:
             raise block.error(
                 f"{axes[0].upper()} word with no G code to use it", axes[0])
@@ -295,6 +680,8 @@ class Interpreter:
         for letter in block.words:
             if letter in ALWAYS_ALLOWED:
                 continue
+            if letter == "q" and self.ref and block.words["q"] == -1.0:
+                continue            # the reference's "no Q" value
             if users is None:
                 users = self._word_users(block, gs, ms, motion)
             if letter not in users:
@@ -309,17 +696,27 @@ class Interpreter:
         moving = (motion != 800 and g0 not in AXIS_USERS_GROUP0
                   and gs.get(8) != 431
                   and (1 in gs or bool(self._axis_words(block))))
-        if moving and motion in (20, 30):
+        if motion in (20, 30) and g0 not in AXIS_USERS_GROUP0:
+            # (the modal arc takes them even on a line without axes)
             allowed |= set("ijkrp")
+
         elif moving and motion == 330:
             allowed.add("k")
+        elif moving and motion == 760:
+            allowed |= set("pijkrqhel")
+        elif moving and motion == 50:
+            allowed |= set("ijpq")
+        elif moving and motion == 51:
+            allowed |= set("ij")
         elif moving and (motion in CANNED or motion in UNSUPPORTED_MOTION):
             allowed |= set("rlpq")
+            if motion == 870:
+                allowed |= set("ijk")
         if g0 == 40:
             allowed.add("p")
         elif g0 == 100:
             allowed |= set("lprijq")
-        if gs.get(8) == 430:
+        if gs.get(8) in (430, 432):
             allowed.add("h")
         if gs.get(13) == 640:
             allowed |= set("pq")
@@ -329,6 +726,10 @@ class Interpreter:
             allowed |= set("pelq")
         if ms.get(6) == 610:
             allowed.add("q")
+        if ms.get(7) == 190:
+            allowed |= set("rqp")
+        if 9 in ms:
+            allowed.add("p")
         return allowed
 
     # -- tools -----------------------------------------------------------
@@ -344,14 +745,18 @@ class Interpreter:
     def _update_tool_params(self) -> None:
         entry = self._tool_of(self.current_tool)
         p = self.params
-        p.set(5400, max(self.current_tool, 0))
+        p.set(5400, max(self.current_tool, 0), internal=True)
         offset = entry.offset if entry is not None else ZERO9
         for i in range(9):
-            p.set(5401 + i, offset[i])
-        p.set(5410, entry.diameter if entry is not None else 0.0)
-        p.set(5411, entry.frontangle if entry is not None else 0.0)
-        p.set(5412, entry.backangle if entry is not None else 0.0)
-        p.set(5413, entry.orientation if entry is not None else 0.0)
+            p.set(5401 + i, offset[i], internal=True)
+        p.set(5410, entry.diameter if entry is not None else 0.0,
+              internal=True)
+        p.set(5411, entry.frontangle if entry is not None else 0.0,
+              internal=True)
+        p.set(5412, entry.backangle if entry is not None else 0.0,
+              internal=True)
+        p.set(5413, entry.orientation if entry is not None else 0.0,
+              internal=True)
 
     def _tool_number(self, block: Block, letter: str) -> int:
         value = block.words[letter]
@@ -376,10 +781,16 @@ class Interpreter:
 
     def _tool_change(self, block: Block, code: int) -> None:
         if code == 60:
+            if self.selected_tool < 0 and self.ref:
+                self.selected_tool = self.selected_pocket = 0
             if self.selected_tool < 0:
                 raise block.error("M6 without a tool selected by a T word",
                                   "m6")
             tool, pocket = self.selected_tool, self.selected_pocket
+            if self.ref:
+                self._trace("START_CHANGE()")
+                self._trace("STOP_SPINDLE_TURNING(0)")
+                self.modal.spindle = 50
             self._emit(C.ChangeTool(tool, pocket, block.line))
             if self.random:
                 if pocket != 0:
@@ -396,7 +807,10 @@ class Interpreter:
             pocket = self._pocket_for(block, tool, "q")
             self._emit(C.ChangeToolNumber(tool, pocket, block.line))
             if not self.random:
-                self._load_spindle(pocket)
+                # (the reference's rs274 leaves its spindle entry as it
+                # was: a G43 after M61 applies no offset there)
+                if not self.ref:
+                    self._load_spindle(pocket)
             elif pocket != 0:
                 old, new = self.tools.entry(0), self.tools.entry(pocket)
                 self.tools.set_entry(0, replace(new, pocket=0))
@@ -406,12 +820,16 @@ class Interpreter:
 
     def _cutter_comp(self, block: Block, code: int) -> None:
         key = code_key("g", code / 10)
+        if code != 400 and self.modal.plane not in (170, 180):
+            raise block.error("cutter compensation works in the XY and "
+                              "XZ planes (G17, G18) only", key)
+        if code != 400 and "d" in block.words:
+            self._pocket_for(block, self._tool_number(block, "d"), "d")
+        self._trace('COMMENT("interpreter: cutter radius compensation '
+                    f'{ {400: "off", 410: "on left", 420: "on right"}[code] }")')
         if code == 400:
             self.comp.stop()
         else:
-            if self.modal.plane != 170:
-                raise block.error("cutter compensation is only supported in "
-                                  "the XY plane (G17)", key)
             tool = (self._tool_number(block, "d") if "d" in block.words
                     else self.current_tool)
             if "d" in block.words:
@@ -419,7 +837,8 @@ class Interpreter:
             entry = self._tool_of(tool)
             radius = entry.diameter / 2 if entry is not None else 0.0
             try:
-                self.comp.start(1 if code == 410 else -1, radius)
+                self.comp.start(1 if code == 410 else -1, radius,
+                                self.modal.plane // 10)
             except CutterRadiusError as e:
                 raise block.error(str(e), key) from None
         self.modal.cutter_comp = code
@@ -444,12 +863,19 @@ class Interpreter:
                 if a in block.words:
                     offset[i] = block.words[a] * self._k(i)
         else:
+            if code == 432 and "h" not in block.words:
+                raise block.error("G43.2 needs an H word", "g43.2")
             tool = (self._tool_number(block, "h") if "h" in block.words
                     else self.current_tool)
             if "h" in block.words:
                 self._pocket_for(block, tool, "h")
             entry = self._tool_of(tool)
+            if self.ref and "h" not in block.words and \
+                    self.tools is not None:
+                entry = self.tools.entry(0)      # the spindle's entry
             offset = list(entry.offset) if entry is not None else [0.0] * 9
+            if code == 432:             # added to the offset in force
+                offset = [a + b for a, b in zip(self.tlo, offset)]
         self.modal.tool_length = code
         self.tlo = [float(v) for v in offset]
         self._emit(C.UseToolLengthOffset(_pose(self.tlo), block.line))
@@ -531,6 +957,8 @@ class Interpreter:
             digital = "p" in block.words
             index = self._index(block, "p" if digital else "e", "M66")
             mode = int(block.words.get("l", 0))
+            if self.ref:
+                return          # the reference's rs274 prints nothing
             if not 0 <= mode <= 4:
                 raise block.error("M66 L must be 0..4", "l")
             if mode and not digital:
@@ -552,6 +980,11 @@ class Interpreter:
             self._emit(C.ProgramPause(line))
         elif code == 10:
             self._emit(C.OptionalPause(line))
+        elif code == 600:
+            self._trace("PALLET_SHUTTLE()")
+            self._emit(C.ProgramPause(line))
+        elif self.ref:
+            self._reference_end(code, line)
         else:
             m = self.modal
             if m.coord_system != 540:
@@ -569,15 +1002,44 @@ class Interpreter:
             self._emit(C.ProgramEnd(code == 300, line))
             self.ended = True
 
+    def _reference_end(self, code: int, line: int) -> None:
+        """M2/M30 with the reference's calls (see :meth:`_stop`)."""
+        m = self.modal
+        m.coord_system = 540
+        self.params.set(5220, 1)
+        self._emit(C.SetG5xOffset(1, _pose(self._g5x()), line))
+        self._trace(f"SET_XY_ROTATION({self.rotation:.4f})")
+        self.comp.stop()
+        if m.plane != 170:
+            self._emit(C.SetPlane(17, line))
+        m.plane, m.distance, m.feed_mode = 170, 900, 940
+        m.cutter_comp, m.motion = 400, 10
+        self._trace("SET_FEED_MODE(0, 0)")
+        self._trace("SET_FEED_RATE(0.0000)")
+        self.feed = self.feed_value = 0.0
+        m.spindle = 50
+        self._emit(C.SpindleOff(line))
+        self._trace("SET_SPINDLE_MODE(0 0.0000)")
+        if m.mist:
+            self._trace("MIST_OFF()")
+        if m.flood:
+            self._trace("FLOOD_OFF()")
+        m.mist = m.flood = False
+        if code == 300:
+            self._trace("PALLET_SHUTTLE()")
+        self._emit(C.ProgramEnd(code == 300, line))
+        self.ended = True
+
     def _control(self, block: Block, code: int) -> None:
         if code == 640:
             p = block.words.get("p")
             q = block.words.get("q")
-            if q is not None and p is None:
-                raise block.error("G64 Q needs a P word", "q")
-            self._emit(C.SetTermCond(
-                "blend", None if p is None else self._len(p),
-                None if q is None else self._len(q), block.line))
+            if q is None and p is not None and self.ref:
+                q = p
+            self.blend = (None if p is None else self._len(p),
+                          None if q is None else self._len(q))
+            self._emit(C.SetTermCond("blend", self.blend[0], self.blend[1],
+                                     block.line))
         else:
             self._emit(C.SetTermCond(
                 "exact_path" if code == 610 else "exact_stop",
@@ -594,32 +1056,50 @@ class Interpreter:
             return
         if level not in (2, 20):
             raise block.error(f"G10 L{level:g} is not supported", "l")
-        if block.words.get("r", 0.0):
-            raise block.error("coordinate system rotation (G10 R) is not "
-                              "supported", "r")
+        if "i" in block.words or "j" in block.words:
+            raise block.error("I and J words are not allowed with G10 "
+                              f"L{level:g}", "g10")
+        if level == 20 and "r" in block.words:
+            raise block.error("R is not allowed with G10 L20", "r")
         p = self._index(block, "p", "G10 L2/L20")
         if p > 9:
             raise block.error(f"G10 P{p}: coordinate systems are 0..9", "p")
         index = p or self.coord_index
         base = 5201 + 20 * index
+        angle = float(self.params.get(base + 9))
+        if level == 20:
+            # the origin that makes the current point read the words
+            target = [self.pos[i] - self.tlo[i] for i in range(9)]
+            want = self.program_position()
+            for i, a in enumerate(AXES):
+                if a in block.words:
+                    want[i] = block.words[a] * self._k(i)
+            v = [want[i] + self.g92[i] for i in range(9)]
+            if angle:
+                v[0], v[1] = _rotate(v[0], v[1], angle)
         for i, a in enumerate(AXES):
             if a in block.words:
                 value = block.words[a] * self._k(i)
                 if level == 20:
-                    value = self.pos[i] - self.tlo[i] - self.g92[i] - value
+                    value = target[i] - v[i]
                 self.params.set(base + i, value)
+        if "r" in block.words:
+            self.params.set(base + 9, block.words["r"])
         if index == self.coord_index:
             self._emit(C.SetG5xOffset(index, _pose(self._g5x()), block.line))
+            self._trace(f"SET_XY_ROTATION({self.rotation:.4f})")
+        else:
+            self._trace('COMMENT("interpreter: setting coordinate system '
+                        'origin")')
 
     def _g92(self, block: Block, code: int) -> None:
         if code == 920:
             if not self._axis_words(block):
                 raise block.error("G92 needs at least one axis word", "g92")
-            g5x = self._g5x()
+            here = self._unrotated(self.pos)
             for i, a in enumerate(AXES):
                 if a in block.words:
-                    self.g92[i] = (self.pos[i] - self.tlo[i] - g5x[i]
-                                   - block.words[a] * self._k(i))
+                    self.g92[i] = here[i] - block.words[a] * self._k(i)
         elif code in (921, 922):
             self.g92 = [0.0] * 9
         else:
@@ -633,12 +1113,14 @@ class Interpreter:
     def _go_home(self, block: Block, code: int) -> None:
         line = block.line
         base = 5161 if code == 280 else 5181
-        home = [self.params.get(base + i) + self.tlo[i] for i in range(9)]
+        # the stored point is where the machine goes (the tool length
+        # offset is not added), as in the reference
+        home = [self.params.get(base + i) for i in range(9)]
         axes = self._axis_words(block)
-        if axes:
+        if axes or self.ref:
             middle = self._target(block)
             self._traverse(middle, line)
-            end = list(self.pos)
+            end = list(self.pos) if axes else list(home)
             for i, a in enumerate(AXES):
                 if a in block.words:
                     end[i] = home[i]
@@ -664,35 +1146,49 @@ class Interpreter:
             raise block.error("feed move with zero feed rate", "")
         return self.feed
 
+    def _inverse_time_trace(self, length: float) -> None:
+        """G93: the reference sets the feed rate of each move."""
+        block = self.line_block
+        if self.ref and self.modal.feed_mode == 930 and block is not None:
+            rate = length / self._k() * block.words.get("f", 0.0)
+            self._trace(f"SET_FEED_RATE({rate:.4f})")
+
     def _straight_feed(self, block: Block, end: list[float]) -> None:
         length = math.dist(self.pos, end)
         feed = self._feed_for(block, length)
+        self._inverse_time_trace(length)
         self._emit(C.StraightFeed(_pose(end), feed, block.line))
         self.pos = list(end)
 
     def _motion(self, block: Block, gs: dict[int, int]) -> None:
         explicit = gs.get(1)
+        self._previous_motion = self.modal.motion
         if explicit is not None:
-            if explicit in UNSUPPORTED_MOTION:
+            if explicit in UNSUPPORTED_MOTION and not self.ref:
                 raise block.error(f"{UNSUPPORTED_MOTION[explicit]} is not "
                                   "supported", code_key("g", explicit / 10))
             self.modal.motion = explicit
             if explicit == 800:
                 self.cycle = {}
+                self._trace('COMMENT("interpreter: motion mode set to '
+                            'none")')
         has_axes = bool(self._axis_words(block))
         if gs.get(0) in AXIS_USERS_GROUP0 or gs.get(8) == 431:
             return
         motion = self.modal.motion
-        if motion == 800 or not (has_axes or explicit is not None):
+        # a centre word alone repeats a modal arc (to where the tool is:
+        # a full circle), as in the reference
+        centre = motion in (20, 30) and any(w in block.words for w in "ijk")
+        if motion == 800 or not (has_axes or explicit is not None or centre):
             return
         line = block.line
         key = code_key("g", motion / 10)
         g53 = gs.get(0) == 530
-        if self.comp.active and (motion not in (0, 10) or g53):
+        if self.comp.active and (motion not in (0, 10, 20, 30) or g53):
             raise block.error(f"G{'53' if g53 else f'{motion / 10:g}'} "
                               "while cutter compensation is on is not "
                               "supported", "g53" if g53 else key)
-        if self.comp.active and has_axes:
+        if self.comp.active and has_axes and motion in (0, 10):
             end = self._target(block)
             feed = None
             if motion == 10:
@@ -707,9 +1203,11 @@ class Interpreter:
             raise block.error("G53 in incremental mode (G91)", "g53")
         if motion in (0, 10, 330) or 382 <= motion <= 385:
             if not has_axes:
-                if motion in (0, 10):
+                # the reference moves to where it is on a G0/G1 alone
+                if motion in (0, 10) and not (self.ref and explicit is not None):
                     return
-                raise block.error(f"G{motion / 10:g} needs an axis word", key)
+                if motion not in (0, 10):
+                    raise block.error(f"G{motion / 10:g} needs an axis word", key)
             end = self._target(block, g53)
             if motion == 0:
                 self._traverse(end, line)
@@ -725,8 +1223,167 @@ class Interpreter:
                 self._probe(block, motion, end)
         elif motion in (20, 30):
             self._arc(block, motion)
+        elif motion == 760:
+            self._g76(block)
+        elif motion in (50, 51):
+            self._spline(block, motion)
         else:
             self._canned(block, motion)
+
+    # -- G5, G5.1 splines ----------------------------------------------------
+    def _spline(self, block: Block, motion: int) -> None:
+        """G5 cubic and G5.1 quadratic B-splines in the XY plane. rs274
+        prints the reference's NURBS_FEED call; a machine gets straight
+        feeds within 1 um (0.00004 in) of the curve."""
+        key = code_key("g", motion / 10)
+        w = block.words
+        if self.modal.plane != 170:
+            raise block.error("splines must be in the XY plane (G17)", key)
+        if any(a in w for a in "zabcuvw"):
+            raise block.error("splines may not move Z, A, B, C, U, V or W",
+                              key)
+        k = self._k()
+        start = list(self.pos)
+        end = self._target(block)
+        p0 = (start[0], start[1])
+        p3 = (end[0], end[1])
+        if motion == 50:
+            if "p" not in w or "q" not in w:
+                raise block.error("G5 needs both P and Q", key)
+            if "i" in w or "j" in w:
+                c1 = (w.get("i", 0.0) * k, w.get("j", 0.0) * k)
+            elif self._previous_motion == 50:
+                # the reflection of the last G5's second control point
+                c1 = (-self._spline_pq[0], -self._spline_pq[1])
+            else:
+                c1 = (0.0, 0.0)
+            pq = (w["p"] * k, w["q"] * k)
+            if self.rotation:
+                c1 = _rotate(c1[0], c1[1], self.rotation)
+                pq = _rotate(pq[0], pq[1], self.rotation)
+            controls = [p0, (p0[0] + c1[0], p0[1] + c1[1]),
+                        (p3[0] + pq[0], p3[1] + pq[1]), p3]
+            self._spline_pq = pq
+        else:
+            if "i" not in w or "j" not in w:
+                raise block.error("G5.1 needs both I and J", key)
+            c1 = (w["i"] * k, w["j"] * k)
+            if self.rotation:
+                c1 = _rotate(c1[0], c1[1], self.rotation)
+            controls = [p0, (p0[0] + c1[0], p0[1] + c1[1]), p3]
+        feed = self._feed_for(block, math.dist(p0, p3))
+        if self.ref:
+            self._trace(f"NURBS_FEED({len(controls)}, ...)")
+            self.pos = list(end)
+            return
+        n = self._spline_segments(controls)
+        for step in range(1, n + 1):
+            x, y = _bezier(controls, step / n)
+            point = list(end)
+            point[0], point[1] = x, y
+            self._emit(C.StraightFeed(_pose(point), feed, block.line))
+        self.pos = list(end)
+
+    def _spline_segments(self, controls: list[tuple[float, float]]) -> int:
+        """Segments that keep the chords within the tolerance: a chord
+        strays at most |B''| / (8 n^2) from the curve."""
+        degree = len(controls) - 1
+        bend = max(math.dist((0.0, 0.0), (
+            a[0] - 2 * b[0] + c[0], a[1] - 2 * b[1] + c[1]))
+            for a, b, c in zip(controls, controls[1:], controls[2:]))
+        second = degree * (degree - 1) * bend
+        tol = 0.001 if self.machine_metric else 0.00004
+        return max(1, min(1000, math.ceil(math.sqrt(second / (8 * tol)))))
+
+    # -- G76 threading ---------------------------------------------------
+    def _g76(self, block: Block) -> None:
+        """The threading cycle: passes of growing depth (J, J*2^(1/R),
+        ... then K), each entered at the compound angle Q, with optional
+        entry/exit tapers (E, L) and H spring passes; ends at the start
+        X and the end Z."""
+        key = "g76"
+        w = block.words
+        for letter in "pzijk":
+            if letter not in w:
+                raise block.error(f"G76 needs the word {letter.upper()}",
+                                  key)
+        k = self._k()
+        half = 0.5 if self.diameter_mode else 1.0
+        pitch = w["p"] * k
+        depth0 = w["j"] * k * half
+        full = w["k"] * k * half
+        offset = w["i"] * k * half
+        degression = w.get("r", 1.0)
+        angle = w.get("q", 0.0)
+        springs = int(w.get("h", 0))
+        taper = w.get("e", 0.0) * k
+        ends = int(w.get("l", 0))
+        if pitch <= 0 or depth0 <= 0 or full <= 0:
+            raise block.error("G76 needs positive P, J and K", key)
+        if degression < 1.0:
+            raise block.error("G76 R (depth degression) must be at least 1",
+                              "r")
+        if springs < 0 or not 0 <= ends <= 3:
+            raise block.error("G76 needs H >= 0 and L 0..3", key)
+        if ends and taper <= 0:
+            raise block.error("G76 L (taper) needs a positive E", "e")
+        prog = self.program_position()
+        start_x, start_z = prog[0], prog[2]
+        end_z = w["z"] * k + (start_z if self.modal.distance == 910 else 0.0)
+        way = -1.0 if end_z < start_z else 1.0
+        inward = 1.0 if offset > 0 else -1.0     # I > 0: internal thread
+        tan_q = math.tan(math.radians(angle))
+        taper_pitch = (pitch * math.hypot(taper, full) / taper
+                       if taper > 0 else pitch)
+        line = block.line
+
+        def at(x: float, z: float) -> list[float]:
+            point = list(prog)
+            point[0], point[2] = x, z
+            return self._to_machine(point)
+
+        def synced(x: float, z: float, rate: float) -> None:
+            end = at(x, z)
+            if self.ref:
+                if self._sync != rate:
+                    self._trace(f"START_SPEED_FEED_SYNC({rate / k:f},0)")
+                    self._sync = rate
+                self._emit(C.StraightFeed(_pose(end), 0.0, line))
+            else:
+                self._emit(C.SyncedFeed(_pose(end), rate, line))
+            self.pos = end
+
+        def thread_pass(depth: float) -> None:
+            # the compound angle moves each pass along Z, away from the
+            # direction of travel by the depth it has reached
+            z0 = start_z + way * depth * tan_q
+            z1 = end_z + way * (depth - full) * tan_q
+            back = start_x + inward * (depth - full)
+            cut = start_x + offset + inward * depth
+            self._traverse(at(back, z0), line)
+            self._sync = None
+            if ends & 1:
+                self._trace("DISABLE_FEED_OVERRIDE()")
+                synced(cut - inward * full, z0, taper_pitch)
+                synced(cut, z0 + way * taper, taper_pitch)
+            else:
+                self._traverse(at(cut, z0), line)
+                self._trace("DISABLE_FEED_OVERRIDE()")
+            synced(cut, z1 - way * taper if ends & 2 else z1, pitch)
+            if ends & 2:
+                synced(cut - inward * full, z1, taper_pitch)
+            self._trace("STOP_SPEED_FEED_SYNCH()")
+            self._traverse(at(back, z1), line)
+            self._trace("ENABLE_FEED_OVERRIDE()")
+
+        n, depth = 1, depth0
+        while depth < full:
+            thread_pass(depth)
+            n += 1
+            depth = depth0 * n ** (1.0 / degression)
+        for _ in range(1 + springs):
+            thread_pass(full)
+        self._traverse(at(start_x, end_z), line)
 
     def _probe(self, block: Block, motion: int, end: list[float]) -> None:
         key = code_key("g", motion / 10)
@@ -744,6 +1401,20 @@ class Interpreter:
     def _arc(self, block: Block, motion: int) -> None:
         key = code_key("g", motion / 10)
         a1, a2, _normal, centre_words = PLANES[self.modal.plane]
+        other = {170: "k", 180: "j", 190: "i"}[self.modal.plane]
+        words = block.words
+        if "r" in words and any(w in words for w in "ijk"):
+            raise block.error("mixed radius and IJK format for an arc", "r")
+        if not ("r" in words or any(w in words for w in "ijk")):
+            raise block.error("R, I, J and K words all missing for an arc",
+                              key)
+        if other in block.words and "r" not in block.words:
+            raise block.error(f"{other.upper()} word given for an arc in the "
+                              f"{ {'k': 'XY', 'j': 'XZ', 'i': 'YZ'}[other]} "
+                              "plane", other)
+        if self.rotation and self.modal.plane != 170:
+            raise block.error("arcs outside G17 in a rotated coordinate "
+                              "system (G10 L2 R) are not supported", key)
         names = AXES[a1].upper() + AXES[a2].upper()
         in_plane = AXES[a1] in block.words or AXES[a2] in block.words
         start = self.pos
@@ -784,12 +1455,13 @@ class Interpreter:
                     raise block.error(
                         f"absolute arc centres (G90.1) need both "
                         f"{w1.upper()} and {w2.upper()}", key)
-                g5x = self._g5x()
-                c1 = (o1 + g5x[a1] + self.g92[a1] + self.tlo[a1]
-                      if w1 in block.words else s1)
-                c2 = (o2 + g5x[a2] + self.g92[a2] + self.tlo[a2]
-                      if w2 in block.words else s2)
+                point = self.program_position()
+                point[a1], point[a2] = o1, o2
+                centre = self._to_machine(point)
+                c1, c2 = centre[a1], centre[a2]
             else:
+                if self.rotation and self.modal.plane == 170:
+                    o1, o2 = _rotate(o1, o2, self.rotation)
                 c1, c2 = s1 + o1, s2 + o2
             r1 = math.hypot(s1 - c1, s2 - c2)
             r2 = math.hypot(e1 - c1, e2 - c2)
@@ -809,8 +1481,17 @@ class Interpreter:
         turn = turns if motion == 30 else -turns
         length = self._arc_length(start, end, (c1, c2), a1, a2, turn)
         feed = self._feed_for(block, length)
-        self._emit(C.ArcFeed(_pose(end), (c1, c2), self.modal.plane // 10,
-                             turn, feed, block.line))
+        self._inverse_time_trace(length)
+        if self.comp.active:
+            try:
+                self.comp.arc(self.pos, end, (c1, c2), turn, feed,
+                              block.line)
+            except CutterRadiusError as e:
+                raise block.error(str(e), key) from None
+        else:
+            self._emit(C.ArcFeed(_pose(end), (c1, c2),
+                                 self.modal.plane // 10, turn, feed,
+                                 block.line))
         self.pos = list(end)
 
     @staticmethod
@@ -838,20 +1519,21 @@ class Interpreter:
         line = block.line
         a1, a2, d, _ = PLANES[self.modal.plane]
         dl = AXES[d]
-        for letter in ("r", dl, "p", "q"):
+        for letter in ("r", dl, "p", "q", "i", "j", "k"):
             if letter in block.words:
                 self.cycle[letter] = block.words[letter]
         for letter in ("r", dl):
             if letter not in self.cycle:
                 raise block.error(f"canned cycle G{motion / 10:g} needs "
                                   f"the word {letter.upper()}", key)
-        if motion in (730, 830) and self.cycle.get("q", 0) <= 0:
+        if motion in (730, 830) and self.cycle.get("q", 0) <= 0 and \
+                not self.ref:
             raise block.error(f"G{motion / 10:g} needs a positive Q word",
                               key)
-        if motion == 840 and self.modal.spindle != 30:
+        if motion == 840 and self.modal.spindle != 30 and not self.ref:
             raise block.error("G84 needs the spindle turning clockwise (M3)",
                               key)
-        if motion == 880 and self.modal.spindle == 50:
+        if motion == 880 and self.modal.spindle == 50 and not self.ref:
             raise block.error("G88 needs the spindle turning", key)
         repeats = int(block.words.get("l", 1))
         if repeats < 0:
@@ -859,6 +1541,11 @@ class Interpreter:
         k = self._k()
         prog = self.program_position()
         old = prog[d]
+        if self.ref:
+            # the reference keeps the level where the cycle started
+            if self._previous_motion != motion or self.cycle_il is None:
+                self.cycle_il = old
+            old = self.cycle_il
         incremental = self.modal.distance == 910
         r = self.cycle["r"] * k + (old if incremental else 0.0)
         bottom = self.cycle[dl] * k + (r if incremental else 0.0)
@@ -872,6 +1559,21 @@ class Interpreter:
         if old < r:
             prog[d] = r
             self._traverse(self._to_machine(prog), line)
+        wrap = self.modal.control != 610
+        if wrap:
+            self._trace("SET_MOTION_CONTROL_MODE(CANON_EXACT_PATH)")
+        if self.ref and motion == 870:
+            for letter in "ijk":
+                if letter not in self.cycle:
+                    raise block.error(f"G87 needs the word {letter.upper()}",
+                                      key)
+        if self.ref and motion in (730, 830) and \
+                self.cycle.get("q", 0) <= 0:
+            raise block.error(f"Q word missing with G{motion // 10}", key)
+        if self.ref and motion in (820, 860, 880, 890) and \
+                "p" not in self.cycle:
+            raise block.error("dwell time P word missing with "
+                              f"G{motion // 10}", key)
         for _ in range(repeats):
             for axis in (a1, a2):
                 letter = AXES[axis]
@@ -879,11 +1581,109 @@ class Interpreter:
                     value = block.words[letter] * self._k(axis)
                     prog[axis] = prog[axis] + value if incremental else value
             self._traverse(self._to_machine(prog), line)
-            prog[d] = r
-            self._traverse(self._to_machine(prog), line)
+            if not (self.ref and prog[d] == r):
+                prog[d] = r
+                self._traverse(self._to_machine(prog), line)
+            if self.ref and motion in (840, 860, 870, 880, 890):
+                self._reference_cycle_body(motion, prog, d, bottom, clear,
+                                           line)
+                continue
             self._cycle_body(motion, prog, d, r, bottom, line)
             prog[d] = clear
             self._traverse(self._to_machine(prog), line)
+        if self.ref and wrap:
+            self._emit(C.SetTermCond(
+                {610: "exact_path", 611: "exact_stop"}.get(
+                    self.modal.control, "blend"),
+                self.blend[0], self.blend[1], line))
+
+    def _reference_cycle_body(self, motion: int, prog: list[float], d: int,
+                              bottom: float, clear: float, line: int) -> None:
+        """G84, G86, G88 and G89 as the reference's rs274 runs them: they
+        end at the clear plane themselves (G88: where the operator
+        withdrew the tool), without the final rapid of the others."""
+        def feed(z: float) -> None:
+            prog[d] = z
+            end = self._to_machine(prog)
+            self._emit(C.StraightFeed(_pose(end), self.feed, line))
+            self.pos = end
+
+        dwell = self.cycle.get("p", 0.0)
+        direction = 1 if self.modal.spindle == 30 else -1
+        if motion == 870:
+            self._back_bore(prog, d, bottom, clear, direction, line)
+            return
+        if motion == 840 and self.modal.spindle != 30:
+            block = self.line_block
+            assert block is not None
+            raise block.error("G84 needs the spindle turning clockwise (M3)",
+                              code_key("g", 84))
+        if motion == 840:
+            self._trace("DISABLE_FEED_OVERRIDE()")
+            self._trace("DISABLE_SPEED_OVERRIDE(0)")
+        feed(bottom)
+        if motion == 840:
+            self._emit(C.SpindleOff(line))
+            self._emit(C.SpindleOn(-1, self.speed, line))
+            self._emit(C.Dwell(dwell, line))
+            feed(clear)
+            self._emit(C.SpindleOff(line))
+            self._emit(C.SpindleOn(1, self.speed, line))
+            self._trace("ENABLE_FEED_OVERRIDE()")
+            self._trace("ENABLE_SPEED_OVERRIDE(0)")
+            return
+        if dwell > 0:
+            self._emit(C.Dwell(dwell, line))
+        if motion == 890:
+            feed(clear)
+        elif motion == 860:
+            self._emit(C.SpindleOff(line))
+            prog[d] = clear
+            self._traverse(self._to_machine(prog), line)
+            self._emit(C.SpindleOn(direction, self.speed, line))
+        else:
+            self._emit(C.SpindleOff(line))
+            self._emit(C.ProgramPause(line))
+            self._emit(C.SpindleOn(direction, self.speed, line))
+
+    def _back_bore(self, prog: list[float], d: int, bottom: float,
+                   clear: float, direction: int, line: int) -> None:
+        """G87 as the reference's rs274 runs it: off to the side by I/J,
+        spindle stopped and oriented, down below the part, back to the
+        centre, bore up to K and down again, then out the same way."""
+        block = self.line_block
+        assert block is not None
+        a1, a2, _, _ = PLANES[self.modal.plane]
+        words = self.cycle
+        k = self._k()
+        x, y = prog[a1], prog[a2]
+        off_x, off_y = x + words["i"] * k, y + words["j"] * k
+        top = words["k"] * k
+
+        def go(px: float, py: float, z: float, feed: bool = False) -> None:
+            prog[a1], prog[a2], prog[d] = px, py, z
+            end = self._to_machine(prog)
+            if feed:
+                self._emit(C.StraightFeed(_pose(end), self.feed, line))
+                self.pos = end
+            else:
+                self._traverse(end, line)
+
+        go(off_x, off_y, prog[d])
+        orient = f"ORIENT_SPINDLE(0, 0.0000, {2 if direction > 0 else 3})"
+        self._emit(C.SpindleOff(line))
+        self._trace(orient)
+        go(off_x, off_y, bottom)
+        go(x, y, bottom)
+        self._emit(C.SpindleOn(direction, self.speed, line))
+        go(x, y, top, feed=True)
+        go(x, y, bottom, feed=True)
+        self._emit(C.SpindleOff(line))
+        self._trace(orient)
+        go(off_x, off_y, bottom)
+        go(off_x, off_y, clear)
+        go(x, y, clear)
+        self._emit(C.SpindleOn(direction, self.speed, line))
 
     def _cycle_body(self, motion: int, prog: list[float], d: int, r: float,
                     bottom: float, line: int) -> None:
@@ -938,8 +1738,27 @@ class Interpreter:
                                        self.speed, line))
 
     # -- predefined named parameters -------------------------------------
+    def _ini_value(self, name: str) -> Optional[float]:
+        """``#<_ini[section]key>``: section and key upper case, as the
+        reference looks them up; None (not defined) unless numeric."""
+        if self.ini is None:
+            return None
+        section, _, key = name[len("_ini["):].partition("]")
+        text = self.ini(section.upper(), key.upper())
+        if text is None:
+            return None
+        try:
+            return float(text)
+        except ValueError:
+            return None
+
     def _predefined(self, name: str) -> Optional[float]:
         name = name.strip("<>").lower()
+        if name.startswith("_ini[") and "]" in name:
+            return self._ini_value(name)
+        if name.isdigit():              # #5420..#5428
+            i = int(name) - 5420
+            return self.program_position()[i] / self._k(i)
         if len(name) == 2 and name[1] in AXES:
             i = AXES.index(name[1])
             return self.program_position()[i] / self._k(i)

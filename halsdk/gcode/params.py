@@ -17,6 +17,14 @@ PERSISTENT: tuple[int, ...] = tuple(
     + [n for base in range(5221, 5382, 20) for n in range(base, base + 10)]
 )
 
+#: The current position in program coordinates (X .. W), read-only
+#: values the interpreter answers through :meth:`Parameters.set_predefined`.
+POSITION = range(5420, 5429)
+
+#: The tool in the spindle (#5400 number, #5401.. offsets, diameter,
+#: angles, orientation): set by the interpreter, read-only for programs.
+READ_ONLY = range(5400, 5414)
+
 #: Numbered parameters local to a subroutine call (its arguments).
 LOCAL_NUMBERED = range(1, 31)
 
@@ -97,8 +105,9 @@ class Parameters:
                        ) -> None:
         """Install the callback answering read-only names such as ``_x``.
 
-        ``fn(name)`` gets the normalized name without ``<>`` and returns
-        its value, or None when it does not know the name.
+        ``fn(name)`` gets the normalized name without ``<>`` (or the
+        number, as a string, of a position parameter #5420..#5428) and
+        returns its value, or None when it does not know it.
         """
         self._predefined = fn
 
@@ -133,19 +142,30 @@ class Parameters:
         number = self._number(key)
         if number in LOCAL_NUMBERED and self.depth:
             return self._frames[-1].numbered.get(number, 0.0)
+        if number in POSITION and self._predefined is not None:
+            # the current position: answered by the interpreter
+            value = self._predefined(str(number))
+            if value is not None:
+                return float(value)
         return self._numbered.get(number, 0.0)
 
     def numbered(self, first: int, count: int) -> list[float]:
         """``#first`` .. ``#first+count-1`` (unset ones read 0), numbers
         above the subroutine locals: what ``get`` reads for them, faster
         (the interpreter reads offsets nine at a time)."""
-        if first <= LOCAL_NUMBERED[-1] or first + count - 1 > MAX_PARAMETER:
+        last = first + count - 1
+        if (first <= LOCAL_NUMBERED[-1] or last > MAX_PARAMETER
+                or (first <= POSITION[-1] and last >= POSITION[0])):
             return [self.get(n) for n in range(first, first + count)]
         get = self._numbered.get
         return [get(n, 0.0) for n in range(first, first + count)]
 
-    def set(self, key: Key, value: float) -> None:
-        """Store ``value`` in parameter ``key`` (in the current scope)."""
+    def set(self, key: Key, value: float, *, internal: bool = False) -> None:
+        """Store ``value`` in parameter ``key`` (in the current scope).
+
+        The tool parameters #5400..#5413 and the position #5420..#5428
+        are read-only for programs, as in the reference; the interpreter
+        sets the tool ones with ``internal=True``."""
         value = float(value)
         if isinstance(key, str):
             name = normalize_name(key)
@@ -159,6 +179,8 @@ class Parameters:
                 self._frames[-1].named[name] = value
             return
         number = self._number(key)
+        if not internal and (number in READ_ONLY or number in POSITION):
+            raise GCodeError(f"parameter #{number} is read-only")
         if number in LOCAL_NUMBERED and self.depth:
             self._frames[-1].numbered[number] = value
         else:

@@ -20,6 +20,7 @@ halsdk ctl ...           operates it from another shell
 halsdk runtests DIR...   runs HAL tests in LinuxCNC's test-folder format
 halsdk web [machine.ini] serves the HAL workbench in a browser
 halsdk latency           runs a latency test of this computer
+halsdk rs274 prog.ngc    prints a G-code program's canonical commands
 halsdk halrun|halcmd ... this halsdk's halrun and halcmd, whichever
                          halrun/halcmd comes first on PATH"""
 
@@ -45,6 +46,9 @@ def _main(argv: Optional[list[str]] = None) -> int:
     if args and args[0] == "latency":
         from halsdk.tools.latency_cli import main as latency_main
         return latency_main(args[1:])
+    if args and args[0] == "rs274":
+        from halsdk.gcode.rs274 import main as rs274_main
+        return rs274_main(args[1:])
     if args and args[0] in ("halrun", "halcmd"):
         # this halsdk's, whichever halrun/halcmd comes first on PATH
         from halsdk.halcmd.cli import halcmd_main, halrun_main
@@ -65,6 +69,10 @@ def _main(argv: Optional[list[str]] = None) -> int:
                    help="serve the HAL workbench of the running instance, "
                         "or start machine.ini and serve its workbench, in "
                         "a browser (halsdk web --help)")
+    sub.add_parser("rs274", add_help=False,
+                   help="the standalone G-code interpreter: print a "
+                        "program's canonical commands in the reference's "
+                        "text format (halsdk rs274 --help)")
     sub.add_parser("halrun", add_help=False,
                    help="this halsdk's halrun, whatever comes first on "
                         "PATH (halsdk halrun --help)")

@@ -218,6 +218,9 @@ class TaskController:
         halsdk-specific [RS274NGC]HALSDK_MAX_ITERATIONS and
         HALSDK_MAX_IDLE_TIME set the bounds of runaway control flow."""
         self.ini_filename = os.path.abspath(ini.path)
+        #: #<_ini[SECTION]KEY> of programs reads this file
+        self.ini_lookup = ini.get
+        self.interp.ini = ini.get
         coords = str(ini.get("TRAJ", "COORDINATES") or "").upper()
         letters = [c for c in coords if c in "XYZABCUVW"]
         if letters:
@@ -250,7 +253,8 @@ class TaskController:
         tools.path = None           # the I/O controller's copy is saved
         interp = Interpreter(self.params, tools, self.executor,
                              random_toolchanger=self.io.table.random,
-                             units=self.units)
+                             units=self.units,
+                             ini=getattr(self, "ini_lookup", None))
         interp.pos = list(self.executor.pos)
         self.executor.interp = interp
         return interp
@@ -467,6 +471,7 @@ class TaskController:
                           max_iterations=self.max_iterations,
                           max_idle_time=self.max_idle_time)
         self._running = program
+        self.interp.program = program     # M73: its call level
         self._start_job(job, program.blocks())
         self.last_command = line
 
@@ -541,6 +546,7 @@ class TaskController:
             raise MachineError(f"program run: {self.file}: {e.strerror}"
                                ) from None
         self._running = program
+        self.interp.program = program     # M73: its call level
         self._start_job(_Job(t, self.file), program.blocks(), start_line)
 
         def finished() -> bool:

@@ -24,7 +24,9 @@ SETUP = st.lists(st.sampled_from([
     "G0", "G1", "G2", "G3", "G80", "G55", "G54", "G59.3", "F0", "F250",
     "G10 L2 P2 X3 Y-4 Z1.5 A10", "G10 L2 P1 X-1 Y2 W7", "G92 X1 Y1",
     "G92.1", "G43.1 Z2.5", "G49", "G0 X1 Y2 Z3", "G1 X-2 Y5 F100",
-    "G91.1", "G90.1"]), max_size=8)
+    "G91.1", "G90.1", "G7", "G8", "G10 L2 P0 R30", "G10 L2 P1 X1 R-15",
+    "G10 L2 P2 R0", "G95", "M70", "M72", "(a comment)", "G5 X1 Y1 P1 Q1"]),
+    max_size=8)
 
 value = st.sampled_from(["0", "1", "-2.5", "0.1234", "10", "-0.5", "3"])
 MOVE = st.tuples(
@@ -33,9 +35,19 @@ MOVE = st.tuples(
              max_size=5, unique_by=lambda w: w[0]))
 
 
+class ReferenceCanon(RecordingCanon):
+    """The canon of ``rs274``: the interpreter adds the reference's calls."""
+    reference_calls = True
+
+
+def canon_of(ref: bool) -> RecordingCanon:
+    return ReferenceCanon() if ref else RecordingCanon()
+
+
 def state(interp: Interpreter, canon: RecordingCanon) -> tuple:
-    return (canon.commands, interp.pos, interp.feed, vars(interp.modal),
-            interp.line, interp.params._numbered)
+    return (canon.commands, interp.pos, interp.feed, interp.feed_value,
+            interp.diameter_mode, vars(interp.modal), interp.line,
+            interp.params._numbered)
 
 
 def outcome(fn, block) -> object:
@@ -47,11 +59,12 @@ def outcome(fn, block) -> object:
 
 
 @settings(max_examples=300, deadline=None)
-@given(SETUP, MOVE)
+@given(SETUP, MOVE, st.booleans())
 def test_plain_moves_take_the_general_path_s_way(setup: list[str],
-                                                 move: tuple) -> None:
+                                                 move: tuple,
+                                                 ref: bool) -> None:
     params = Parameters()
-    canon = RecordingCanon()
+    canon = canon_of(ref)
     fast = Interpreter(params, None, canon)
     try:
         fast.run(Program("\n".join(setup) + "\n", "s.ngc", params))
@@ -92,10 +105,11 @@ small = st.sampled_from(["0", "1", "-2.5", "0.1234", "3", "-0.75"])
 @given(SETUP, st.sampled_from(["G2", "G3", ""]), small, small,
        st.sampled_from(["", " Z1", " Z-0.5 A3"]),
        st.sampled_from(["", " P2", " P1", " P0.5", " F120"]),
-       st.sampled_from(["G17", "G18", "G19"]))
+       st.sampled_from(["G17", "G18", "G19"]), st.booleans())
 def test_arcs_take_the_general_path_s_way(setup: list[str], code: str,
                                           i: str, j: str, helix: str,
-                                          extra: str, plane: str) -> None:
+                                          extra: str, plane: str,
+                                          ref: bool) -> None:
     # incremental: the end is twice the centre offset, a half circle
     setup = setup + [f"{plane} G91 G91.1 F100"]
     first, second, w1, w2 = {"G17": ("X", "Y", "I", "J"),
@@ -106,7 +120,7 @@ def test_arcs_take_the_general_path_s_way(setup: list[str], code: str,
     move = (f"{code} {first}{2 * float(i)} {second}{2 * float(j)} "
             f"{w1}{i} {w2}{j}{helix}{extra}")
     params = Parameters()
-    fast = Interpreter(params, None, RecordingCanon())
+    fast = Interpreter(params, None, canon_of(ref))
     try:
         fast.run(Program("\n".join(setup) + "\n", "s.ngc", params))
     except GCodeError:

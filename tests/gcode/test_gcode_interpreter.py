@@ -177,9 +177,11 @@ def test_arc_errors():
     assert "too small" in str(err("F1 G2 X10 R2\n"))
     assert "full circle" in str(err("F1 G2 X0 Y0 R2\n"))
     assert "both missing" in str(err("F1 G2 Z1 R1\n"))
-    assert "both missing" in str(err("F1 G2 X1\n"))
+    assert "all missing" in str(err("F1 G2 X1\n"))
     assert "need both" in str(err("F1 G90.1 G2 X1 I1\n"))
-    assert "P (turns)" in str(err("G0 X1\nF1 G2 I-1 P0.5\n"))
+    assert "P (turns)" in str(err("G0 X1\nF1 G2 X1 I-1 P0.5\n"))
+    # as in the reference, an arc or a cycle needs an axis word
+    assert "all axes missing" in str(err("G0 X1\nF1 G38.2\n"))
 
 
 def test_absolute_arc_centre_g90_1():
@@ -223,7 +225,27 @@ def test_g10_l20_and_g92_family():
     assert interp.g92[0] == 5
     interp.execute(next(iter(Program("G92.1\n").blocks())))
     assert interp.g92[0] == 0 and p.get(5211) == 0 and p.get(5210) == 0
-    assert "not supported" in str(err("G10 L2 P1 R30\n"))
+
+
+def test_g10_l2_rotation_turns_about_the_g5x_origin():
+    # G10 L2 R: program X1 Y0 in a system at (5, 5) turned 90 degrees
+    interp, rec = run("G10 L2 P1 X5 Y5 R90\nG0 X1 Y0\n")
+    end = moves(rec)[-1].end
+    assert end[0] == pytest.approx(5) and end[1] == pytest.approx(6)
+    assert interp.params.get(5230) == 90
+    assert interp.program_position()[0] == pytest.approx(1)
+    # an incremental centre turns with the system: a half circle from
+    # program (0, 0) to (2, 0) about (1, 0) has its machine centre at (5, 6)
+    interp, rec = run("G10 L2 P1 X5 Y5 R90\nG0 X0 Y0\n"
+                      "G2 X2 Y0 I1 J0 F100\n")
+    arc = rec.of_type(C.ArcFeed)[-1]
+    assert arc.center == pytest.approx((5, 6))
+    assert arc.end[:2] == pytest.approx((5, 7))
+    # G92 in a rotated system: the current point reads the given value
+    interp, _ = run("G10 L2 P1 R30\nG0 X3 Y4\nG92 X0 Y0\n")
+    assert interp.program_position()[:2] == pytest.approx([0, 0])
+    assert "not supported" in str(err("G10 L2 P1 R30\nG18\n"
+                                      "G2 X1 Z1 R1 F10\n"))
 
 
 def test_g92_persisted_in_parameters_restored_at_start():
@@ -448,8 +470,10 @@ def test_g84_g88_retract_modes_and_repeats():
 def test_g84_g88_errors():
     e = err("S100 M3 F10\nG84 Z-1\n")
     assert (e.line, e.column) == (2, 1) and "needs the word R" in str(e)
-    e = err("S100 M3 F10\nG88 R1\n")
+    e = err("S100 M3 F10\nG88 X1 R1\n")
     assert (e.line, e.column) == (2, 1) and "needs the word Z" in str(e)
+    e = err("S100 M3 F10\nG88 R1\n")
+    assert (e.line, e.column) == (2, 1) and "all axes missing" in str(e)
     e = err("S100 M4 F10\n G84 R1 Z-1\n")
     assert (e.line, e.column) == (2, 2) and "clockwise" in str(e)
     e = err("F10\nG88 R1 Z-1\n")
@@ -538,8 +562,9 @@ def test_cutter_comp_z_moves_and_refusals():
              for c in rec.of_type(C.StraightFeed)]
     assert feeds[:2] == [(-3, 0, 5), (-3, 0, -1)]
     assert xy(rec.of_type(C.ArcFeed)[0]) == (0, 3)
-    assert "not supported" in str(err("G41 D1\nG2 X1 Y1 R1 F1\n"))
-    assert "XY plane" in str(err("G18 G41 D1\n"))
+    assert "too big" in str(err("G0 X-9\nG41 D1 G1 X0 F1\nG3 X4 R2\n"))
+    assert "XZ planes" in str(err("G19 G41 D1\n"))
+    assert "change the plane" in str(err("G18 G41 D1\nG17\n"))
     assert "already on" in str(err("G41 D1\nG42 D1\n"))
     assert "tool 9" in str(err("G41 D9\n"))
 
@@ -597,3 +622,84 @@ def test_probe_kinds_and_no_tool_table():
     with pytest.raises(GCodeError, match="tool 1 is not in the tool table"):
         interp.execute(Block("a.ngc", 3, "T1", words={"t": 1},
                              columns={"t": 1}))
+
+
+def test_m70_m72_and_m73_restore_the_modal_state():
+    interp, rec = run("G21 F100 M70\nG18 G20 G91 F2\nM72\nG1 X1\n")
+    assert interp.modal.plane == 170 and interp.modal.units == 210
+    assert interp.modal.distance == 900
+    assert rec.of_type(C.SetPlane)[-1].plane == 17
+    assert rec.of_type(C.SetFeedRate)[-1].feed == pytest.approx(100)
+    assert moves(rec)[-1].end[0] == pytest.approx(1)
+    # M73: the state of the caller comes back when the subroutine returns
+    interp, rec = run("o1 sub\nM73\nG20 G91\no1 endsub\no1 call\nG0 X1\n")
+    assert interp.modal.units == 210 and interp.modal.distance == 900
+    assert moves(rec)[-1].end[0] == pytest.approx(1)
+    assert "M72 without" in str(err("M70\nM71\nM72\n"))
+
+
+def test_g76_threading_passes():
+    # external thread from X1 Z1 to Z-1: depths 0.02, 0.04, then K 0.05
+    _, rec = run("G18 G0 X1 Z1\nG76 P0.1 Z-1 I-0.1 J0.02 K0.05\n")
+    synced = rec.of_type(C.SyncedFeed)
+    assert [round(c.end[0], 6) for c in synced] == [0.88, 0.86, 0.85]
+    assert all(c.pitch == pytest.approx(0.1) for c in synced)
+    assert all(round(c.end[2], 6) == -1 for c in synced)
+    # it ends at the start X and the end Z
+    assert xyz(moves(rec)[-1]) == (1, 0, -1)
+    # a spring pass repeats the last depth
+    _, rec = run("G18 G0 X1 Z1\nG76 P0.1 Z-1 I-0.1 J0.02 K0.05 H1\n")
+    assert len(rec.of_type(C.SyncedFeed)) == 4
+    assert "needs the word K" in str(err("G76 P0.1 Z-1 I-0.1 J0.02\n"))
+
+
+def test_cutter_comp_on_arcs_meets_the_offset_lines():
+    # tool radius 3 left of a clockwise arc: its offset path has radius 13
+    _, rec = run("G0 X-10 Y0\nG41 D1 G1 X0 Y0 F100\nG2 X20 Y0 I10 J0\n"
+                 "G1 X30\nG40\n")
+    feeds = rec.of_type(C.StraightFeed)
+    h = math.sqrt(13 ** 2 - 3 ** 2)
+    assert xyz(feeds[0]) == pytest.approx((10 - h, 3, 0))
+    arc = rec.of_type(C.ArcFeed)[0]
+    assert arc.center == pytest.approx((10, 0)) and arc.turn == -1
+    assert xyz(arc) == pytest.approx((10 + h, 3, 0))
+    assert xyz(feeds[1]) == pytest.approx((30, 3, 0))
+
+
+def test_g5_splines_become_short_feeds_on_the_curve():
+    _, rec = run("G5 I0 J10 P0 Q10 X10 Y0 F100\n")
+    feeds = rec.of_type(C.StraightFeed)
+    assert len(feeds) > 10
+    assert xyz(feeds[-1]) == (10, 0, 0)
+    # the curve 0,0 -> 10,0 with controls (0,10), (10,10) peaks at 7.5
+    assert max(c.end[1] for c in feeds) == pytest.approx(7.5, abs=1e-3)
+    # G5.1: a parabola through its control's midpoints; both I and J
+    _, rec = run("G5.1 I5 J10 X10 Y0 F100\n")
+    assert max(c.end[1] for c in rec.of_type(C.StraightFeed)) == \
+        pytest.approx(5, abs=1e-3)
+    assert "both I and J" in str(err("G5.1 I5 X10 F100\n"))
+    assert "XY plane" in str(err("G18 G5 I1 J1 P1 Q1 X1 F100\n"))
+
+
+def test_ini_named_parameters_read_the_ini_upper_case():
+    values = {("AXIS_X", "MAX_LIMIT"): "10.5", ("SETUP", "NAME"): "text"}
+    interp, rec = make()
+    interp.ini = lambda section, key: values.get((section, key))
+    interp.run(Program("G0 X#<_ini[axis_x]max_limit>\n"
+                       "#1 = [EXISTS[#<_ini[AXIS_X]NOPE>]]\n",
+                       params=interp.params))
+    assert xyz(moves(rec)[-1]) == (10.5, 0, 0)
+    assert interp.params.get(1) == 0
+    with pytest.raises(GCodeError, match="not defined"):
+        interp.run(Program("#2 = #<_ini[setup]name>\n",
+                           params=interp.params))
+    with pytest.raises(GCodeError, match="read-only"):
+        interp.run(Program("#<_ini[axis_x]max_limit> = 1\n",
+                           params=interp.params))
+
+
+def test_tool_and_position_parameters_are_read_only():
+    for number in (5400, 5413, 5420, 5428):
+        assert "read-only" in str(err(f"#{number} = 1\n"))
+    interp, _ = run("#5399 = 2\n#5429 = 3\nT1 M6\n")
+    assert interp.params.get(5429) == 3 and interp.params.get(5400) == 1
