@@ -50,7 +50,7 @@ def server():
 
 def coils(port: int, first: int, n: int) -> list[bool]:
     from pymodbus.client import ModbusTcpClient
-    c = ModbusTcpClient("127.0.0.1", port=port, timeout=1, retries=0)
+    c = ModbusTcpClient("127.0.0.1", port=port, timeout=3, retries=3)
     assert c.connect()
     try:
         return list(c.read_coils(first, count=n, device_id=1).bits[:n])
@@ -60,7 +60,7 @@ def coils(port: int, first: int, n: int) -> list[bool]:
 
 def set_coils(port: int, first: int, values: list[bool]) -> None:
     from pymodbus.client import ModbusTcpClient
-    c = ModbusTcpClient("127.0.0.1", port=port, timeout=1, retries=0)
+    c = ModbusTcpClient("127.0.0.1", port=port, timeout=3, retries=3)
     assert c.connect()
     try:
         c.write_coils(first, values, device_id=1)

@@ -38,7 +38,7 @@ def free_port() -> int:
 
 def client(port):
     from pymodbus.client import ModbusTcpClient
-    c = ModbusTcpClient("127.0.0.1", port=port, timeout=1, retries=0)
+    c = ModbusTcpClient("127.0.0.1", port=port, timeout=3, retries=3)
     assert c.connect()
     return c
 
