@@ -26,7 +26,7 @@ PAGES = ["index", "concepts", "tutorial", "components", "halcmd", "runtests",
          "halcompile", "python-api", "cython-components", "c-components",
          "motion", "running", "latency", "machine", "tooltable", "gcode", "drivers",
          "driver-realtime", "driver-sim-io", "driver-cia402", "driver-whb04b",
-         "driver-mqtt", "driver-candbc", "driver-mb2hal", "homing",
+         "driver-mqtt", "driver-candbc", "driver-mb2hal", "driver-hm2", "homing",
          "kinematics", "architecture", "design", "compat", "benchmarks",
          "reliability", "web"]
 
@@ -35,8 +35,8 @@ PAGES = ["index", "concepts", "tutorial", "components", "halcmd", "runtests",
 def site(tmp_path_factory: pytest.TempPathFactory) -> str:
     out = tmp_path_factory.mktemp("docs-html")
     proc = subprocess.run(
-        [sys.executable, "-m", "sphinx", "-W", "--keep-going", "-b", "html",
-         "-d", str(out / ".doctrees"), DOCS, str(out)],
+        [sys.executable, "-m", "sphinx", "-W", "--keep-going", "-j", "2",
+         "-b", "html", "-d", str(out / ".doctrees"), DOCS, str(out)],
         capture_output=True, text=True, cwd=str(out))   # not the source tree
     assert proc.returncode == 0, (
         f"sphinx failed ({proc.returncode}):\n{proc.stdout[-3000:]}\n"
