@@ -13,6 +13,8 @@ extension module ``halsdk.components.<name>``:
   homemod, tpmod, the kinematics) and their C/C++ sources in
   ``components/motion/``; C++ sources link ruckig (a build requirement)
   statically.
+- ``drivers/<name>/MODULES`` lists realtime C drivers the same way
+  (installed as ``halsdk.drivers.<module>``).
 """
 
 import glob
@@ -106,9 +108,12 @@ def ruckig_dirs():
     return os.path.join(root, "include"), lib
 
 
-def motion_extensions():
-    """The modules listed in components/motion/MODULES."""
-    folder = os.path.join("components", "motion")
+MOTION = os.path.join("components", "motion")
+
+
+def motion_extensions(folder=MOTION, package="halsdk.components"):
+    """The modules listed in FOLDER/MODULES (components/motion/MODULES,
+    and drivers/<name>/MODULES for the realtime C drivers)."""
     exts = []
     with open(os.path.join(folder, "MODULES"), encoding="utf-8") as f:
         lines = f.read().splitlines()
@@ -129,7 +134,7 @@ def motion_extensions():
             # not throw
             extra = {"extra_objects": [lib], "language": "c++"}
         exts.append(Extension(
-            "halsdk.components." + name.strip(),
+            f"{package}.{name.strip()}",
             sources=["halsdk/core/src/c_module.c"] + sources,
             include_dirs=["halsdk/include", folder]
             + ([include] if cxx else []),
@@ -143,6 +148,11 @@ def motion_extensions():
 
 
 components += motion_extensions()
+# realtime drivers in C: drivers/<name>/MODULES, installed as
+# halsdk.drivers.<module>
+for modules in sorted(glob.glob(os.path.join("drivers", "*", "MODULES"))):
+    components += motion_extensions(os.path.dirname(modules),
+                                    "halsdk.drivers")
 components.append(Extension(
     "halsdk.motion._channel", sources=["halsdk/motion/_channel.pyx"],
     include_dirs=["components/motion", "halsdk/include"],
