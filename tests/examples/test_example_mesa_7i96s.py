@@ -150,8 +150,9 @@ def test_home_and_run_part_on_the_simulated_7i96s(card, tmp_path):
             # the watchdog is in the E-stop chain: if the servo thread was
             # held up at the start for longer than its timeout, reset it
             # (as the operator would) before leaving E-stop
+            # (its pin is on the signal card-bit)
             if halcmd(machine, "getp", f"{CARD}.watchdog.has_bit") == "TRUE":
-                halcmd(machine, "setp", f"{CARD}.watchdog.has_bit", "0")
+                halcmd(machine, "sets", "card-bit", "0")
                 time.sleep(0.05)
             c.estop_reset()
             c.on()
