@@ -472,11 +472,27 @@ static int load_board(struct hm2_board *b, int i)
         HM2_ERR(b, "too many registers to read in one packet");
         r = -ENOSPC;
     }
-    if (!r)
-        r = lbp16_rx_count(&b->link, &b->tx_count);
     if (r < 0)
         return r;
+    /* the modules' set-up goes to the card now, as the reference's does
+       at load, so the first cycles are short; the watchdog sleeps until
+       the first write function */
+    lbp16_pkt_reset(&b->wr);
     b->force_write = 1;
+    hm2_gpio_prepare(b);
+    hm2_encoder_prepare(b);
+    hm2_stepgen_prepare(b, 1000000);
+    hm2_pwmgen_prepare(b);
+    hm2_led_prepare(b);
+    r = lbp16_send(&b->link, &b->wr);
+    b->force_write = 0;
+    if (!r)
+        r = lbp16_rx_count(&b->link, &b->tx_count);
+    if (r < 0) {
+        HM2_ERR(b, "%s: the set-up of the modules failed: %s",
+                b->link.where, strerror(-r));
+        return -ENODEV;
+    }
     return 0;
 }
 

@@ -644,3 +644,44 @@ def test_encoder_hires_timestamp(rig):
     rig.set("encoder.hires-timestamp", 1)   # 10 MHz: the divider changes
     rig.cycle(20)
     assert rig.get("encoder.00.velocity") == pytest.approx(-3000, rel=0.01)
+
+
+def test_lost_datagrams_on_the_way_to_the_card(rig):
+    """A lost read request times out; a lost write is seen in the next
+    cycle, from the card's count of datagrams: two errors."""
+    rig.set("packet-read-timeout", 20_000_000)
+    rig.cycle(3)
+    rig.sim.faults.lose(next=2)             # this cycle's request and write
+    rig.cycle(1)
+    assert rig.get("packet-error") and rig.get("packet-error-total") == 1
+    rig.cycle(1)
+    assert rig.get("packet-error") and rig.get("packet-error-total") == 2
+    rig.cycle(1)
+    assert not rig.get("packet-error") and rig.get("packet-error-total") == 2
+
+
+def test_a_card_left_bitten_starts_clean(hal, sim):
+    rig = load(hal, sim, CONFIG)
+    rig.cycle(5)
+    sim.step(0.02)                          # the HAL stops: the card bites
+    assert sim.watchdog_bitten
+    hal.unloadrt("hm2_eth")                 # ... and a new run loads
+    hal.loadrt("hm2_eth", f"board_ip=127.0.0.1:{sim.port}",
+               f'config="{CONFIG}"')
+    assert not sim.watchdog_bitten
+    hal.addf(rig.p + "read", "servo")
+    hal.addf(rig.p + "write", "servo")
+    rig.set("packet-read-timeout", 200_000_000)
+    rig.set("gpio.040.is_output", 1)
+    rig.cycle(3)
+    assert not rig.get("watchdog.has_bit") and sim.is_output(40)
+
+
+def test_duplicated_replies_are_not_taken_twice(rig):
+    rig.cycle(2)
+    rig.sim.faults.duplicate(next=3)
+    for counts in (5, 9, 14, 20):
+        rig.sim.set_encoder(0, counts)
+        rig.cycle(1)
+        assert rig.get("encoder.00.count") == counts
+    assert rig.get("packet-error-total") == 0

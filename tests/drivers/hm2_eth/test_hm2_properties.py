@@ -56,3 +56,38 @@ def test_stepgen_reaches_any_target_within_limits(rig, target, maxvel,
         last = v
     assert rig.get(s + "position-fb") == pytest.approx(goal, abs=0.011)
     assert abs(last) < 1e-6
+
+
+#: the 7i96S's firmware: instances of each module the config names
+AVAILABLE = {"num_encoders": 1, "num_stepgens": 5, "num_pwmgens": 1,
+             "num_leds": 4}
+
+
+@settings(max_examples=20, **SETTINGS)
+@given(counts=st.dictionaries(st.sampled_from(sorted(AVAILABLE)),
+                              st.integers(-1, 7), max_size=4),
+       extra=st.sampled_from(["", "enable_raw", "sserial_port_0=xxxx",
+                              "num_dplls=-1", "firmware=x.bit"]))
+def test_config_counts(hal, sim, counts, extra):
+    """Any counts of the supported modules: the load succeeds exactly
+    when none asks for more than the card has, and makes that many."""
+    from halsdk.errors import InvalidError
+    config = " ".join([f"{k}={v}" for k, v in counts.items()] + [extra])
+    ok = all(v <= AVAILABLE[k] for k, v in counts.items())
+    try:
+        hal.loadrt("hm2_eth", f"board_ip=127.0.0.1:{sim.port}",
+                   f'config="{config}"')
+    except InvalidError as exc:
+        assert not ok, f"{config!r}: {exc}"
+        return
+    assert ok, f"{config!r} loaded"
+    try:
+        for key, pattern in (("num_encoders", "encoder.*.count"),
+                             ("num_stepgens", "stepgen.*.counts"),
+                             ("num_pwmgens", "pwmgen.*.value"),
+                             ("num_leds", "led.*")):
+            want = counts.get(key, -1)
+            want = AVAILABLE[key] if want < 0 else want
+            assert len(hal.pins(f"hm2_7i96s.0.{pattern}")) == want, key
+    finally:
+        hal.unloadrt("hm2_eth")
