@@ -400,6 +400,7 @@ int hm2_watchdog_setup(struct hm2_board *b, int comp_id);
 void hm2_watchdog_process(struct hm2_board *b);
 void hm2_watchdog_prepare(struct hm2_board *b);
 int hm2_watchdog_blocked(struct hm2_board *b);
+void hm2_watchdog_bite_now(struct hm2_board *b);
 
 int hm2_encoder_setup(struct hm2_board *b, int comp_id);
 void hm2_encoder_process(struct hm2_board *b, long period);

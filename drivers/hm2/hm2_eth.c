@@ -538,8 +538,10 @@ int rtapi_app_main(void)
 void rtapi_app_exit(void)
 {
     int i;
-    for (i = 0; i < num_boards; i++)
+    for (i = 0; i < num_boards; i++) {
+        hm2_watchdog_bite_now(boards[i]);
         lbp16_close(&boards[i]->link);
+    }
     num_boards = 0;
     hal_exit(comp_id);
 }

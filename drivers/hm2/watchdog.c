@@ -19,13 +19,14 @@
 
 enum { R_TIMER, R_STATUS, R_RESET };
 #define WD_PET 0x5a000000u
+#define WD_DISABLED 0x80000000u     /* a timer with bit 31 set never bites */
 #define WD_DEFAULT_TIMEOUT_NS 5000000u
 
 int hm2_watchdog_setup(struct hm2_board *b, int comp_id)
 {
     struct hm2_watchdog *wd = &b->wd;
     int r;
-    u32 zero = 0;
+    u32 zero = 0, off = WD_DISABLED;
 
     wd->md = hm2_find_module(b, HM2_GTAG_WATCHDOG);
     wd->present = wd->md != NULL && wd->md->instances > 0;
@@ -42,6 +43,12 @@ int hm2_watchdog_setup(struct hm2_board *b, int comp_id)
     wd->timeout_ns = WD_DEFAULT_TIMEOUT_NS;
     wd->enabled = 0;
     wd->was_bit = 0;
+    /* a watchdog still running from an earlier run (a driver that died)
+       would bite between this load and the first write function: stop
+       it until then */
+    r = lbp16_write32(&b->link, hm2_reg_addr(wd->md, R_TIMER), &off, 1);
+    if (r < 0)
+        return r;
     /* a card left bitten by an earlier run starts clean */
     r = lbp16_write32(&b->link, hm2_reg_addr(wd->md, R_STATUS), &zero, 1);
     if (r < 0)
@@ -101,4 +108,13 @@ void hm2_watchdog_prepare(struct hm2_board *b)
     }
     v = WD_PET;
     hm2_write_regs(b, wd->md, R_RESET, 1, &v);
+}
+
+/* at unload: the card's outputs go to their safe state at once, rather
+   than at the end of the timeout (a card without a watchdog keeps them) */
+void hm2_watchdog_bite_now(struct hm2_board *b)
+{
+    u32 one = 1;
+    if (b->wd.present)
+        lbp16_write32(&b->link, hm2_reg_addr(b->wd.md, R_TIMER), &one, 1);
 }

@@ -182,6 +182,41 @@ def test_watchdog_bites_when_the_thread_stops(rig):
     assert sim.is_output(40) and not sim.pin(40)
 
 
+def test_unloading_the_driver_bites_at_once(rig):
+    """Unloaded, the driver leaves no output driven: the card's watchdog
+    bites at once, not at the end of its timeout."""
+    sim = rig.sim
+    rig.set("watchdog.timeout_ns", 500_000_000)
+    rig.set("gpio.040.is_output", 1)
+    rig.cycle(5)
+    assert sim.is_output(40)
+    before = sim.stats.requests
+    rig.hal.unloadrt("hm2_eth")
+    assert sim.wait_requests(before + 1, 2.0)
+    sim.step(0.001)                     # far less than the 500 ms
+    assert sim.watchdog_bitten and not sim.is_output(40)
+
+
+def test_loading_stops_a_watchdog_left_running(hal, sim):
+    """A watchdog still counting from an earlier run (a driver that died)
+    does not bite between the load and the first write function."""
+    from halsdk.drivers.hm2sim import lbp16
+    from halsdk.drivers.hm2sim.profiles import WATCHDOG_BASE
+    before = sim.stats.requests
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+        # the timer of a run that died: 1000 ticks, then a bite
+        s.sendto(lbp16.encode([lbp16.write(0, WATCHDOG_BASE, [1000])]),
+                 ("127.0.0.1", sim.port))
+    assert sim.wait_requests(before + 1, 2.0)
+    rig = load(hal, sim, "num_stepgens=1", functs=())
+    sim.step(0.050)                     # no write function yet
+    assert not sim.watchdog_bitten
+    for f in ("read", "write"):
+        hal.addf(rig.p + f, "servo")
+    rig.cycle(3)
+    assert not rig.get("watchdog.has_bit") and not sim.watchdog_bitten
+
+
 def test_watchdog_timeout_param(rig):
     rig.set("watchdog.timeout_ns", 50_000_000)
     rig.cycle(3)
