@@ -20,8 +20,8 @@ import subprocess
 import sys
 import tempfile
 import time
-from collections.abc import Iterator, Mapping, Sequence
-from typing import Optional
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from typing import IO, Optional
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(HERE)
@@ -52,6 +52,23 @@ def add_repeat(p: argparse.ArgumentParser, default: int, what: str) -> None:
     """``--repeat R`` (a whole number from 1): ``what`` it does."""
     p.add_argument("--repeat", type=_at_least_one, default=default,
                    help=f"{what} (default {default})")
+
+
+def add_thread_runs(p: argparse.ArgumentParser, threads: str) -> None:
+    """``--seconds``, ``--warmup``, ``--repeat`` and ``--sched`` of a
+    bench that runs HAL threads, ours and the reference's, alternating;
+    ``threads`` names ours in the help ("our thread", "our threads")."""
+    p.add_argument("--seconds", type=float, default=5.0,
+                   help="length of each measurement (default 5)")
+    p.add_argument("--warmup", type=float, default=1.0,
+                   help="run time before the measurement (default 1)")
+    add_repeat(p, 3, "runs per side, alternating; the table shows the "
+                     "median")
+    p.add_argument("--sched", choices=("both", "realtime", "normal"),
+                   default="both",
+                   help=f"{threads} with realtime scheduling (SCHED_FIFO, "
+                        "when we may), normal scheduling, or both "
+                        "(default both)")
 
 
 def add_no_reference(p: argparse.ArgumentParser) -> None:
@@ -120,6 +137,34 @@ def session(cmd: Sequence[str], **popen: object) -> Iterator[subprocess.Popen]:
         if proc.poll() is None:
             os.killpg(proc.pid, signal.SIGTERM)
             proc.wait(timeout=10)
+
+
+def sleeping_child(pid: int, hold: str) -> bool:
+    """Our halrun has started its threads once it runs ``sleep hold``."""
+    r = subprocess.run(["pgrep", "-P", str(pid), "-f", f"^sleep {hold}$"],
+                       capture_output=True, text=True)
+    return bool(r.stdout.strip())
+
+
+def wait_host(proc: subprocess.Popen, log: IO[str], hold: str,
+              reference_host: Optional[Callable[[str], Optional[int]]],
+              what: str, timeout: float = 120) -> int:
+    """The pid of the process that runs the HAL threads of ``proc``, once
+    they run: the reference's rtapi_app (``reference_host(hold)`` finds
+    it) or our halrun (which then runs ``sleep hold``). RuntimeError with
+    the end of ``log`` if ``proc`` ends first or ``timeout`` passes."""
+    deadline = time.monotonic() + timeout
+    while True:
+        if reference_host is not None:
+            host = reference_host(hold)
+        else:
+            host = proc.pid if sleeping_child(proc.pid, hold) else None
+        if host:
+            return host
+        if proc.poll() is not None or time.monotonic() > deadline:
+            log.seek(0)
+            raise RuntimeError(f"{what}: run failed:\n" + log.read()[-3000:])
+        time.sleep(0.02)
 
 
 class RunError(RuntimeError):

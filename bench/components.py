@@ -62,6 +62,7 @@ from benchlib import (  # noqa: E402
     run_folder,
     session,
     use_reference,
+    wait_host,
 )
 from thread_overhead import (  # noqa: E402
     our_rtapi_app,
@@ -173,17 +174,8 @@ def run_once(case: Case, loaded: bool, seconds: float, warmup: float,
             tempfile.TemporaryFile("w+") as log, \
             session(cmd, cwd=folder, stdout=log, stderr=subprocess.STDOUT,
                     env=env) as proc:
-        deadline = time.monotonic() + 120
-        while True:
-            host = our_rtapi_app(hold) if reference else \
-                (proc.pid if _sleeping_child(proc.pid, hold) else None)
-            if host:
-                break
-            if proc.poll() is not None or time.monotonic() > deadline:
-                log.seek(0)
-                raise RuntimeError(f"{case.name}: run failed:\n"
-                                   + log.read()[-2000:])
-            time.sleep(0.02)
+        host = wait_host(proc, log, hold,
+                         our_rtapi_app if reference else None, case.name)
         time.sleep(warmup)
         t0, c0 = time.monotonic(), process_cpu(host)
         time.sleep(seconds)
@@ -200,11 +192,6 @@ def run_once(case: Case, loaded: bool, seconds: float, warmup: float,
         return Result((c1 - c0) * 1e9 / cycles, statistics.median(values))
 
 
-def _sleeping_child(pid: int, hold: str) -> bool:
-    """Our halrun has started its threads once it runs ``sleep hold``."""
-    r = subprocess.run(["pgrep", "-P", str(pid), "-f", f"^sleep {hold}$"],
-                       capture_output=True, text=True)
-    return bool(r.stdout.strip())
 
 
 def _run_locked(case: Case, loaded: bool, seconds: float, warmup: float,

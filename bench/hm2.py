@@ -77,11 +77,12 @@ from benchlib import (  # noqa: E402
     REFERENCE_TOOL,
     REPO,
     add_no_reference,
-    add_repeat,
+    add_thread_runs,
     reference_lock,
     run_folder,
     session,
     use_reference,
+    wait_host,
 )
 from stepper_machine import NORMAL_HALRUN, scheduling, wakeups  # noqa: E402
 from thread_overhead import our_rtapi_app, process_cpu, rtapi_apps  # noqa: E402
@@ -224,10 +225,6 @@ class Run:
     wakeups: float              # voluntary context switches per cycle
 
 
-def _sleeping_child(pid: int, hold: str) -> bool:
-    r = subprocess.run(["pgrep", "-P", str(pid), "-f", f"^sleep {hold}$"],
-                       capture_output=True, text=True)
-    return bool(r.stdout.strip())
 
 
 def run_once(card: Card, seconds: float, warmup: float, reference: bool,
@@ -249,17 +246,8 @@ def run_once(card: Card, seconds: float, warmup: float, reference: bool,
             tempfile.TemporaryFile("w+") as log, \
             session(cmd, cwd=folder, stdout=log, stderr=subprocess.STDOUT,
                     env=env) as proc:
-        deadline = time.monotonic() + 120
-        while True:
-            host = our_rtapi_app(hold) if reference else \
-                (proc.pid if _sleeping_child(proc.pid, hold) else None)
-            if host:
-                break
-            if proc.poll() is not None or time.monotonic() > deadline:
-                log.seek(0)
-                raise RuntimeError(f"run failed ({side}):\n"
-                                   + log.read()[-3000:])
-            time.sleep(0.02)
+        host = wait_host(proc, log, hold,
+                         our_rtapi_app if reference else None, side)
         sched = scheduling(host)
         s0 = card.stats()
         t0, c0, w0 = time.monotonic(), process_cpu(host), wakeups(host)
@@ -392,16 +380,7 @@ def main(argv: Optional[list[str]] = None) -> int:
         description=__doc__.split("\n\n")[0],
         epilog="Needs root (a network namespace); see the module docstring "
                "and docs/benchmarks.md.")
-    p.add_argument("--seconds", type=float, default=5.0,
-                   help="length of each measurement (default 5)")
-    p.add_argument("--warmup", type=float, default=1.0,
-                   help="run time before the measurement (default 1)")
-    add_repeat(p, 3, "runs per side, alternating; the table shows the "
-                     "median")
-    p.add_argument("--sched", choices=("both", "realtime", "normal"),
-                   default="both",
-                   help="our thread with realtime scheduling (SCHED_FIFO), "
-                        "normal scheduling, or both (default both)")
+    add_thread_runs(p, "our thread")
     p.add_argument("--markdown", action="store_true",
                    help="print the table as Markdown")
     add_no_reference(p)

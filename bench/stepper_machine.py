@@ -89,11 +89,12 @@ from benchlib import (  # noqa: E402
     REFERENCE_TOOL,
     add_keep,
     add_no_reference,
-    add_repeat,
+    add_thread_runs,
     reference_lock,
     run_folder,
     session,
     use_reference,
+    wait_host,
 )
 from thread_overhead import (  # noqa: E402
     our_rtapi_app,
@@ -288,10 +289,6 @@ def wakeups(pid: int) -> int:
     return total
 
 
-def _sleeping_child(pid: int, hold: str) -> bool:
-    r = subprocess.run(["pgrep", "-P", str(pid), "-f", f"^sleep {hold}$"],
-                       capture_output=True, text=True)
-    return bool(r.stdout.strip())
 
 
 #: our halrun with ``start`` under normal scheduling (as the reference's
@@ -328,18 +325,9 @@ def run_once(seconds: float, warmup: float, reference: bool,
             tempfile.TemporaryFile("w+") as log, \
             session(cmd, cwd=folder, stdout=log, stderr=subprocess.STDOUT,
                     env=env) as proc:
-        deadline = time.monotonic() + 120
-        while True:
-            host = our_rtapi_app(hold) if reference else \
-                (proc.pid if _sleeping_child(proc.pid, hold) else None)
-            if host:
-                break
-            if proc.poll() is not None or time.monotonic() > deadline:
-                log.seek(0)
-                raise RuntimeError("run failed ("
-                                   + ("reference" if reference else "ours")
-                                   + "):\n" + log.read()[-3000:])
-            time.sleep(0.02)
+        host = wait_host(proc, log, hold,
+                         our_rtapi_app if reference else None,
+                         "reference" if reference else "ours")
         sched = scheduling(host)
         t0, c0, w0 = time.monotonic(), process_cpu(host), wakeups(host)
         time.sleep(seconds)
@@ -453,17 +441,7 @@ def report(a: argparse.Namespace, ours: dict[str, list[Run]],
 
 def main(argv: Optional[list[str]] = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    p.add_argument("--seconds", type=float, default=5.0,
-                   help="length of each measurement (default 5)")
-    p.add_argument("--warmup", type=float, default=1.0,
-                   help="run time before the measurement (default 1)")
-    add_repeat(p, 3, "runs per side, alternating; the table shows the "
-                     "median")
-    p.add_argument("--sched", choices=("both", "realtime", "normal"),
-                   default="both",
-                   help="our threads with realtime scheduling (SCHED_FIFO, "
-                        "when we may), normal scheduling, or both "
-                        "(default both)")
+    add_thread_runs(p, "our threads")
     add_no_reference(p)
     add_keep(p)
     a = p.parse_args(argv)

@@ -208,21 +208,28 @@ def _strip_ascii(text: str, file: str, lineno: int
             break
         char = text[i]
         if char == "(":
-            end = text.find(")", i + 1)
-            if end < 0:
-                raise GCodeError("unclosed comment: '(' without ')'",
-                                 file, lineno, i + 1)
-            nested = text.find("(", i + 1, end)
-            if nested >= 0:
-                raise GCodeError("nested comment: '(' inside a comment",
-                                 file, lineno, nested + 1)
-            comments.append(_comment(text[i + 1:end], i + 1))
-            i = end + 1
+            comment, i = _paren_comment(text, i, file, lineno)
+            comments.append(comment)
         elif char == ";":
             comments.append(Comment(text[i + 1:].strip(), "", i + 1))
             break
         # else white space: the next search skips it
     return "".join(parts).lower(), columns, comments
+
+
+def _paren_comment(text: str, i: int, file: str, lineno: int
+                   ) -> tuple[Comment, int]:
+    """The comment that opens at ``text[i]`` (a ``(``) and the index
+    after its ``)``."""
+    end = text.find(")", i + 1)
+    if end < 0:
+        raise GCodeError("unclosed comment: '(' without ')'",
+                         file, lineno, i + 1)
+    nested = text.find("(", i + 1, end)
+    if nested >= 0:
+        raise GCodeError("nested comment: '(' inside a comment",
+                         file, lineno, nested + 1)
+    return _comment(text[i + 1:end], i + 1), end + 1
 
 
 def _strip(text: str, file: str, lineno: int
@@ -235,16 +242,8 @@ def _strip(text: str, file: str, lineno: int
     while i < len(text):
         char = text[i]
         if char == "(":
-            end = text.find(")", i + 1)
-            if end < 0:
-                raise GCodeError("unclosed comment: '(' without ')'",
-                                 file, lineno, i + 1)
-            nested = text.find("(", i + 1, end)
-            if nested >= 0:
-                raise GCodeError("nested comment: '(' inside a comment",
-                                 file, lineno, nested + 1)
-            comments.append(_comment(text[i + 1:end], i + 1))
-            i = end + 1
+            comment, i = _paren_comment(text, i, file, lineno)
+            comments.append(comment)
             continue
         if char == ";":
             comments.append(Comment(text[i + 1:].strip(), "", i + 1))
