@@ -242,8 +242,10 @@ struct hm2_stepgen_inst {
     double old_pos_cmd;
     double cur_vel;             /* commanded velocity, units/s */
     double fb_pos;
-    u32 w_steplen, w_stepspace, w_dirsetup, w_dirhold, w_mode;
+    u32 w_steplen, w_stepspace, w_dirsetup, w_dirhold, w_mode, w_width;
     int timing_written;
+    u32 w_table[4];             /* table-data as last written */
+    u32 w_table_len;            /* entries last written (0: none) */
 };
 
 struct hm2_stepgen {

@@ -8,6 +8,15 @@
  * (times in ticks of the module's clock), 7 table data, 8 table width,
  * 9 the master DDS of the module (written all ones: the full clock).
  *
+ * Table mode (step_type 3 to 16: the sequence's length) drives the
+ * instance's pins from a table of byte-wide entries, one per phase; the
+ * card advances through it one entry per step, forward or back.  The
+ * table-data-N params hold four entries each (entry 4N in the low byte).
+ * The table data register is a shift register: each write pushes one
+ * entry in, so the entries are written one per write, last entry first.
+ * They are written when table mode is on and the data, the length or
+ * the mode changed (and on a forced write).
+ *
  * The card only generates a rate; the position loop is here.  In
  * position mode, each write computes the velocity that reaches the
  * commanded position (plus its feed-forward velocity) within maxvel and
@@ -27,6 +36,7 @@
 #include "hm2.h"
 
 #define TIMING_MAX 0x3fff         /* ticks: the timing registers' width */
+#define TABLE_MAX 16              /* the longest step table */
 
 enum { R_RATE, R_ACCUM, R_MODE, R_DIRSETUP, R_DIRHOLD, R_STEPLEN,
        R_STEPSPACE, R_TABLE, R_TABLEWIDTH, R_MASTER_DDS };
@@ -186,6 +196,44 @@ static double step_velocity(struct hm2_stepgen_inst *s, double dt,
     return target;
 }
 
+/* the table's length: step_type, at most TABLE_MAX */
+static u32 table_len(const struct hm2_stepgen_inst *s)
+{
+    return s->step_type > TABLE_MAX ? TABLE_MAX : s->step_type;
+}
+
+/* in table mode, push the table into instance i's table data register
+   when it changed (or when the mode registers were just written) */
+static void write_table(struct hm2_board *b, int i, int force)
+{
+    struct hm2_stepgen *sg = &b->sg;
+    struct hm2_stepgen_inst *s = &sg->inst[i];
+    u16 addr;
+    u32 n, j;
+    int changed = force;
+
+    if (s->step_type < 3) {
+        s->w_table_len = 0;     /* leaving table mode: rewrite on return */
+        return;
+    }
+    n = table_len(s);
+    for (j = 0; j < 4; j++)
+        if (s->table_data[j] != s->w_table[j])
+            changed = 1;
+    if (n != s->w_table_len)
+        changed = 1;
+    if (!changed)
+        return;
+    addr = (u16)(hm2_reg_addr(sg->md, R_TABLE) + i * sg->md->instance_stride);
+    for (j = n; j-- > 0;) {
+        u32 entry = (s->table_data[j / 4] >> (8 * (j % 4))) & 0xffu;
+        hm2_queue_write(b, addr, &entry, 1);
+    }
+    for (j = 0; j < 4; j++)
+        s->w_table[j] = s->table_data[j];
+    s->w_table_len = n;
+}
+
 void hm2_stepgen_prepare(struct hm2_board *b, long period)
 {
     struct hm2_stepgen *sg = &b->sg;
@@ -220,11 +268,15 @@ void hm2_stepgen_prepare(struct hm2_board *b, long period)
         stepspace[i] = ticks(s->stepspace, sg->clock_hz);
         dirsetup[i] = ticks(s->dirsetup, sg->clock_hz);
         dirhold[i] = ticks(s->dirhold, sg->clock_hz);
-        mode[i] = s->step_type > 3 ? 3 : s->step_type;
-        width[i] = s->step_type >= 3 ? s->step_type : 0;
+        /* as the reference's driver writes them: table mode is the
+           step type with its two low bits set, the width the table's
+           last index */
+        mode[i] = s->step_type >= 3 ? (s->step_type | 3) : s->step_type;
+        width[i] = s->step_type >= 3 ? table_len(s) - 1 : 0;
         if (steplen[i] != s->w_steplen || stepspace[i] != s->w_stepspace
             || dirsetup[i] != s->w_dirsetup || dirhold[i] != s->w_dirhold
-            || mode[i] != s->w_mode || !s->timing_written)
+            || mode[i] != s->w_mode || width[i] != s->w_width
+            || !s->timing_written)
             timing = 1;
     }
     if (timing || b->force_write) {
@@ -246,8 +298,13 @@ void hm2_stepgen_prepare(struct hm2_board *b, long period)
             s->w_dirsetup = dirsetup[i];
             s->w_dirhold = dirhold[i];
             s->w_mode = mode[i];
+            s->w_width = width[i];
             s->timing_written = 1;
         }
+    }
+    if (sg->md->num_registers > R_TABLE) {
+        for (i = 0; i < sg->num; i++)
+            write_table(b, i, timing || b->force_write);
     }
     hm2_write_regs(b, sg->md, R_RATE, sg->num, sg->rate);
 }

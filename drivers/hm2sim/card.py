@@ -32,6 +32,9 @@ REG_STRIDE = 0x100
 INSTANCE_STRIDE = 4
 #: one step in the stepgen's DDS accumulator (the register shows bits 47..16)
 STEP_UNITS = 1 << 32
+#: the stepgen mode register's table mode, and the longest step table
+TABLE_MODE = 3
+TABLE_ENTRIES = 16
 WATCHDOG_COOKIE = 0x5A
 WATCHDOG_DISABLED = 0x80000000
 #: LBP16 status space: the count of UDP datagrams the card received
@@ -74,9 +77,26 @@ class StepGen:
     dir_hold: int = 0
     step_len: int = 0
     step_space: int = 0
-    table: int = 0
-    table_max: int = 0
+    table: int = 0                  # the last table entry written
+    table_max: int = 0              # the table's last index (length - 1)
     direction: bool = False         # the direction output (True: reverse)
+    #: the step table, a shift register: each write to the table data
+    #: register pushes an entry in at 0 (so the last written is entry 0)
+    table_data: list[int] = field(
+        default_factory=lambda: [0] * TABLE_ENTRIES)
+    table_index: int = 0            # the table entry on the pins
+
+    @property
+    def table_length(self) -> int:
+        """Entries the table mode steps through (1..16): the width
+        register holds the last index, as the reference's driver writes
+        it (step_type - 1)."""
+        return min(self.table_max + 1, TABLE_ENTRIES)
+
+    @property
+    def table_output(self) -> int:
+        """The pins' levels in table mode (bit k: module pin k + 1)."""
+        return self.table_data[self.table_index]
 
     @property
     def steps(self) -> float:
@@ -254,8 +274,13 @@ class Card:
             return
         for sg in self.stepgens:
             if sg.rate:
+                before = sg.units // STEP_UNITS
                 sg.units += sg.rate * delta
                 sg.direction = sg.rate < 0
+                if (sg.mode & 3) == TABLE_MODE:
+                    # each step moves one entry, forward or back
+                    sg.table_index = ((sg.table_index + sg.units // STEP_UNITS
+                                       - before) % sg.table_length)
         # the encoders move at the end of the interval (their timestamps)
         self.ticks = ticks
         for n, enc in enumerate(self.encoders):
@@ -337,6 +362,8 @@ class Card:
         num = d.sec_pin & 0x7F
         if d.sec_tag == GTAG_STEPGEN and d.sec_unit < len(self.stepgens):
             sg = self.stepgens[d.sec_unit]
+            if (sg.mode & 3) == TABLE_MODE:
+                return bool(sg.table_output >> (num - 1) & 1)
             return sg.direction if num == 2 else False
         if d.sec_tag == GTAG_PWMGEN and d.sec_unit < len(self.pwm_value):
             on = bool(self.pwm_enable >> d.sec_unit & 1)
@@ -475,6 +502,7 @@ class Card:
                                       "step_len", "step_space", "table",
                                       "table_max"), 2):
                 attr(reg(STEPGEN_BASE, r, n), sg, name)
+            wr[reg(STEPGEN_BASE, 7, n)] = partial(self._sg_table, sg)
         if self.stepgens:
             store(reg(STEPGEN_BASE, 9))                 # master rate (DDS)
         for n, enc in enumerate(self.encoders):
@@ -518,6 +546,12 @@ class Card:
 
     def _sg_rate(self, sg: StepGen, value: int) -> None:
         sg.rate = 0 if self.watchdog.bitten else _s32(value)
+
+    @staticmethod
+    def _sg_table(sg: StepGen, value: int) -> None:
+        sg.table = value & 0xFF
+        sg.table_data[1:] = sg.table_data[:-1]
+        sg.table_data[0] = sg.table
 
     @staticmethod
     def _sg_get_rate(sg: StepGen) -> int:

@@ -15,7 +15,7 @@ from types import TracebackType
 from typing import Optional, TextIO, Union
 
 from . import lbp16
-from .card import Card, Coupling, Switch
+from .card import TABLE_MODE, Card, Coupling, Switch
 from .profiles import Profile, profile
 
 #: the longest a select() of the server thread waits, so stop() is prompt
@@ -474,7 +474,10 @@ class Hm2Sim:
             return self.card.axis_steps(n)
 
     def stepgen(self, n: int) -> dict[str, float]:
-        """The registers and position of stepgen ``n``."""
+        """The registers and position of stepgen ``n``; in table mode
+        (``mode`` 3) ``table_index`` is the step table's entry on the
+        pins and ``table_output`` its value (bit k: module pin k + 1);
+        :meth:`step_table` lists the entries."""
         with self._lock:
             self._check("stepgen", n, self.card.stepgens)  # type: ignore[arg-type]
             self._sync()
@@ -484,7 +487,21 @@ class Hm2Sim:
                     "steps_per_second": sg.rate * self.card.clock / 2**32,
                     "mode": sg.mode, "dir_setup": sg.dir_setup,
                     "dir_hold": sg.dir_hold, "step_len": sg.step_len,
-                    "step_space": sg.step_space}
+                    "step_space": sg.step_space,
+                    "table_length": sg.table_length
+                    if sg.mode & 3 == TABLE_MODE else 0,
+                    "table_index": sg.table_index,
+                    "table_output": sg.table_output}
+
+    def step_table(self, n: int) -> list[int]:
+        """The step table of stepgen ``n`` as loaded: its
+        ``table_length`` entries (all 16 out of table mode)."""
+        with self._lock:
+            self._check("stepgen", n, self.card.stepgens)  # type: ignore[arg-type]
+            sg = self.card.stepgens[n]
+            return list(sg.table_data[:sg.table_length
+                                      if sg.mode & 3 == TABLE_MODE
+                                      else len(sg.table_data)])
 
     def set_encoder(self, n: int, counts: int) -> None:
         """Move encoder ``n``'s simulated position to ``counts``."""

@@ -3,6 +3,7 @@ hm2-sim: loading, names, the modules and the packet errors."""
 
 from __future__ import annotations
 
+import math
 import socket
 import time
 
@@ -307,7 +308,7 @@ def test_stepgen_disable_stops_at_once(rig):
 
 
 @pytest.mark.parametrize("step_type, mode", [(0, 0), (1, 1), (2, 2),
-                                              (3, 3), (6, 3)])
+                                              (3, 3), (6, 7), (16, 19)])
 def test_stepgen_timings_and_step_type(rig, step_type, mode):
     s = "stepgen.03."
     rig.set(s + "steplen", 5000)            # ns; 100 MHz clock: 500 ticks
@@ -321,6 +322,86 @@ def test_stepgen_timings_and_step_type(rig, step_type, mode):
     assert (reg["dir_setup"], reg["dir_hold"]) == (3, 0)
     assert reg["mode"] == mode
     assert rig.sim.stepgen(2)["step_len"] == 0x3FFF     # the default
+
+
+FULL_STEP = [0x3, 0x6, 0xC, 0x9]        # 4-phase full step, two coils on
+WAVE = [0x1, 0x2, 0x4, 0x8]             # one coil at a time
+
+
+def table_words(table):
+    """The table-data-N params of ``table``: four entries a word, the
+    first in the low byte."""
+    words = [0, 0, 0, 0]
+    for k, entry in enumerate(table):
+        words[k // 4] |= entry << (8 * (k % 4))
+    return words
+
+
+def set_table(rig, s, table):
+    for k, word in enumerate(table_words(table)):
+        rig.set(s + f"table-data-{k}", word)
+
+
+def move_recording_phases(rig, s, n, target, cycles=100):
+    rig.set(s + "position-cmd", target)
+    seen = []
+    for _ in range(cycles):
+        rig.cycle()
+        reg = rig.sim.stepgen(n)
+        seen.append((math.floor(reg["position"]), reg["table_index"],
+                     reg["table_output"]))
+    return seen
+
+
+def test_stepgen_table_mode_follows_the_table(rig):
+    n = 1
+    s = setup_stepgen(rig, n=n, scale=1.0, maxvel=200.0, maxaccel=0.0)
+    rig.set(s + "step_type", len(FULL_STEP))
+    set_table(rig, s, FULL_STEP)
+    rig.cycle(2)
+    reg = rig.sim.stepgen(n)
+    # the reference's registers: mode = step type | 3, width = length - 1
+    assert (reg["mode"], reg["table_length"]) == (7, 4)
+    assert rig.sim.step_table(n) == FULL_STEP
+    assert (reg["table_index"], reg["table_output"]) == (0, 0x3)
+    for target, way in ((6.0, 1), (-3.0, -1)):
+        seen = move_recording_phases(rig, s, n, target)
+        # at most one step a cycle (200 steps/s, 1 ms): every phase in
+        # order, forward then back, and the pins show the table
+        for (p0, i0, _), (p1, i1, _) in zip(seen, seen[1:]):
+            assert p1 - p0 in (0, way)
+            assert (i1 - i0) % 4 == (p1 - p0) % 4
+        for step, index, output in seen:
+            assert index == step % 4 and output == FULL_STEP[index]
+        assert {index for _, index, _ in seen} == {0, 1, 2, 3}
+        # the position still counts steps
+        assert rig.sim.axis_position(n) == pytest.approx(target, abs=0.5)
+        assert rig.get(s + "counts") == pytest.approx(target, abs=1)
+    # another table, loaded while running, drives the same phase index
+    set_table(rig, s, WAVE)
+    rig.cycle(2)
+    assert rig.sim.step_table(n) == WAVE
+    reg = rig.sim.stepgen(n)
+    assert reg["table_output"] == WAVE[reg["table_index"]]
+    # the other stepgens are not in table mode and got no table
+    assert rig.sim.stepgen(0)["mode"] == 0
+    assert rig.sim.step_table(0) == [0] * 16
+
+
+def test_stepgen_table_length_follows_step_type(rig):
+    s = "stepgen.00."
+    table = [0x1, 0x3, 0x2, 0x6, 0x4, 0xC, 0x8, 0x9]    # 4-phase half step
+    set_table(rig, s, table)
+    rig.cycle(1)
+    assert rig.sim.step_table(0) == [0] * 16    # not in table mode: unsent
+    rig.set(s + "step_type", 8)
+    rig.cycle(2)
+    assert rig.sim.stepgen(0)["table_length"] == 8
+    assert rig.sim.step_table(0) == table
+    rig.set(s + "step_type", 5)                 # a shorter table: resent
+    rig.cycle(2)
+    assert rig.sim.stepgen(0)["table_length"] == 5
+    assert rig.sim.step_table(0) == table[:5]
 
 
 def test_stepgen_position_reset(rig):

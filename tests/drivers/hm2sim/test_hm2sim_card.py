@@ -271,3 +271,58 @@ def test_encoder_timestamp_of_the_last_count(card: Card) -> None:
     assert rd(card, 0x3300) == 10_500
     card.set_encoder(0, 20)                     # set now: stamped now
     assert rd(card, ENC_COUNT) >> 16 == 10_500
+
+
+STEP_MODE = 0x2200
+STEP_TABLE = 0x2700
+STEP_TABLE_MAX = 0x2800
+
+
+def load_table(card: Card, n: int, table: list[int]) -> None:
+    """Table mode on stepgen ``n`` as the reference's driver sets it: the
+    mode is the step type (the length) with its low bits 3, the width the
+    last index, the entries written last first."""
+    wr(card, STEP_MODE + 4 * n, len(table) | 3)
+    wr(card, STEP_TABLE_MAX + 4 * n, len(table) - 1)
+    for entry in reversed(table):
+        wr(card, STEP_TABLE + 4 * n, entry)
+
+
+def test_table_data_is_a_shift_register(card: Card) -> None:
+    load_table(card, 1, [0x1, 0x2, 0x4, 0x8])
+    sg = card.stepgens[1]
+    assert sg.table_data[:4] == [0x1, 0x2, 0x4, 0x8]
+    assert sg.table_length == 4 and sg.table_output == 0x1
+    wr(card, STEP_TABLE + 4, 0x1FF)             # one more: a byte pushed in
+    assert sg.table_data[:5] == [0xFF, 0x1, 0x2, 0x4, 0x8]
+    assert card.stepgens[0].table_data == [0] * 16
+
+
+@given(st.lists(st.integers(0, 0xFF), min_size=3, max_size=16),
+       st.lists(st.integers(-3000, 3000), min_size=1, max_size=6))
+@settings(max_examples=40, deadline=None)
+def test_table_mode_steps_through_the_table(table: list[int],
+                                           speeds: list[int]) -> None:
+    card = Card(profile("7i96s"))
+    load_table(card, 0, table)
+    sg = card.stepgens[0]
+    step_pin, dir_pin = (
+        next(i for i, d in enumerate(card.profile.pins)
+             if d.sec_tag == 5 and d.sec_unit == 0 and d.sec_pin & 0x7F == k)
+        for k in (1, 2))
+    wr(card, PORT_DDR, 0xFFFFFF)
+    wr(card, PORT_ALT, 0xFFFFFF)
+    wr(card, PORT_DDR + 4, 0xFFFFFF)
+    wr(card, PORT_ALT + 4, 0xFFFFFF)
+    for k, sps in enumerate(speeds):           # 10 ms at each speed
+        wr(card, RATE, rate_of(sps))
+        card.advance_to((k + 1) / 100)
+        steps = sg.units // 2**32              # whole steps from 0
+        assert sg.table_index == steps % len(table)
+        entry = table[sg.table_index]
+        assert sg.table_output == entry
+        # the stepgen's pins show the entry's bits 0 and 1
+        assert card.pin_level(step_pin) == bool(entry & 1)
+        assert card.pin_level(dir_pin) == bool(entry & 2)
+    # the position still counts steps
+    assert rd(card, ACCUM) == (sg.units >> 16) & 0xFFFFFFFF
