@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Cost per call of shipped components: pid, stepgen, encoder, siggen, limit3.
+"""Cost per call of shipped components: pid, stepgen, encoder, pwmgen, siggen,
+limit3.
 
 Each case is one HAL file, run the same way by our ``halrun`` and, when
 LinuxCNC 2.9 is installed, by the reference's (through the project's
@@ -15,6 +16,8 @@ stepgen       16 channels, ``stepgen.make-pulses`` in a 25 us base thread
               ``capture-position`` in a 1 kHz thread
 encoder       8 channels, ``encoder.update-counters`` and
               ``encoder.capture-position`` in a 1 kHz thread
+pwmgen        8 channels of PWM at 1 kHz, ``pwmgen.make-pulses`` in a
+              25 us base thread, ``pwmgen.update`` in a 1 kHz thread
 siggen        16 x ``siggen.N.update`` in a 1 kHz thread
 limit3        16 x ``limit3.N`` (a moving target) in a 1 kHz thread
 ============  ==============================================================
@@ -114,6 +117,12 @@ def cases() -> list[Case]:
            "addf encoder.update-counters servo",
            "addf encoder.capture-position servo"]
     enc += [f"setp encoder.{i}.position-scale 4" for i in range(8)]
+    pwm = ["loadrt pwmgen output_type=" + ",".join(["0"] * 8)]
+    for i in range(8):
+        pwm += [f"setp pwmgen.{i}.pwm-freq 1000",
+                f"setp pwmgen.{i}.value {0.10 + 0.05 * i:.2f}",
+                f"setp pwmgen.{i}.enable 1"]
+    pwm += ["addf pwmgen.make-pulses base", "addf pwmgen.update servo"]
     sig = [f"loadrt siggen num_chan={n}"]
     sig += [f"setp siggen.{i}.frequency {i + 1}" for i in range(n)]
     sig += [f"addf siggen.{i}.update servo" for i in range(n)]
@@ -134,6 +143,12 @@ def cases() -> list[Case]:
         Case("encoder", _servo(), enc, "servo", SERVO, 8,
              "update-counters + capture-position, 8 channels (per "
              "channel)"),
+        Case("pwmgen",
+             [f"loadrt threads name1=base period1={BASE} "
+              f"name2=servo period2={SERVO}"],
+             pwm, "base", BASE, 8,
+             "make-pulses, 8 channels of PWM at 1 kHz, duty 10 to 45 % "
+             "(per channel; the 1 kHz update included)"),
         Case("siggen", _servo(), sig, "servo", SERVO, n,
              f"{n} x update"),
         Case("limit3", _servo(), lim, "servo", SERVO, n, f"{n} x limit3"),
