@@ -84,7 +84,12 @@ from benchlib import (  # noqa: E402
     use_reference,
     wait_host,
 )
-from stepper_machine import NORMAL_HALRUN, scheduling, wakeups  # noqa: E402
+from stepper_machine import (  # noqa: E402
+    NORMAL_HALRUN,
+    same_side,
+    scheduling,
+    wakeups,
+)
 from thread_overhead import our_rtapi_app, process_cpu, rtapi_apps  # noqa: E402
 
 PERIOD = 1_000_000
@@ -308,14 +313,6 @@ def med(runs: list[Run], attr: str) -> Optional[float]:
 def cell(runs: list[Run], attr: str, spec: str) -> str:
     v = med(runs, attr)
     return "-" if v is None else format(v, spec)
-
-
-def same_side(ours: dict[str, list[Run]], ref: list[Run]) -> list[Run]:
-    """Our runs under the scheduling the reference got."""
-    normal = bool(ref) and all(r.sched == "normal" for r in ref)
-    if normal and ours["normal"]:
-        return ours["normal"]
-    return ours["realtime"] or ours["normal"]
 
 
 def report(a: argparse.Namespace, ours: dict[str, list[Run]],

@@ -9,7 +9,7 @@ first, M2 last). The reference's ``rs274 -g`` runs it in a fresh folder
 (one at a time, at most 20 s each) and our rs274 runs it in-process; a
 program whose standard output (``-0.0000`` read as ``0.0000``) or exit
 status differs is printed with the reference's message and saved in
-``--keep`` (default /tmp/rs274-fuzz) as ``misN.ngc``: copy the useful
+``--keep`` (default rs274-fuzz in the temp folder) as ``misN.ngc``: copy the useful
 ones to ``errors/`` and run regenerate.py on them. Run by hand, never by
 the test suite (it needs the reference).
 """
@@ -25,6 +25,9 @@ import sys
 import tempfile
 
 from halsdk.gcode.rs274 import run
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from regenerate import DEFAULT_REFERENCE  # noqa: E402
 
 CODES = ["G0", "G1", "G2", "G3", "G17", "G18", "G19", "G20", "G21", "G90",
          "G91", "G54", "G55", "G92", "G92.1", "G28", "G81", "G83", "G80",
@@ -50,8 +53,9 @@ def main() -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--seed", type=int, default=1)
     p.add_argument("--count", type=int, default=100)
-    p.add_argument("--reference", default="/work/shared/tools/reference")
-    p.add_argument("--keep", default="/tmp/rs274-fuzz")
+    p.add_argument("--reference", default=DEFAULT_REFERENCE)
+    p.add_argument("--keep", default=os.path.join(tempfile.gettempdir(),
+                                                  "rs274-fuzz"))
     a = p.parse_args()
     rnd = random.Random(a.seed)
     os.makedirs(a.keep, exist_ok=True)

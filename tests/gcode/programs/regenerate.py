@@ -35,7 +35,11 @@ import tempfile
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
-DEFAULT_REFERENCE = "/work/shared/tools/reference"
+#: the reference tool beside the checkout (../shared/tools/reference), as
+#: bench/benchlib.py finds it; HALSDK_REFERENCE_TOOL overrides it
+DEFAULT_REFERENCE = os.environ.get(
+    "HALSDK_REFERENCE_TOOL",
+    str(HERE.parents[2].parent / "shared" / "tools" / "reference"))
 
 
 def is_library(path: Path) -> bool:
