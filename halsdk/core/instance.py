@@ -426,6 +426,13 @@ def _teardown(conn: Connection) -> None:
 @atexit.register
 def _close_at_exit() -> None:
     if _conn is not None:
+        # the process is ending: a second Ctrl-C (halrun's unloadusr, an
+        # impatient user) must not cut the teardown short, which would
+        # print a traceback and leave the component half removed
+        import signal
+        import threading
+        if threading.current_thread() is threading.main_thread():
+            signal.signal(signal.SIGINT, signal.SIG_IGN)
         _teardown(_conn)
 
 

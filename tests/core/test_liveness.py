@@ -371,3 +371,32 @@ def test_component_that_exits_normally_is_not_marked(hal, tmp_path):
     subprocess.run([sys.executable, "-c", code], cwd=tmp_path, check=True,
                    env=child_env(), timeout=60)
     assert hal.find("component", "tidy") is None
+
+
+def test_a_ctrl_c_during_the_exit_does_not_cut_the_teardown(tmp_path,
+                                                           hosts):
+    """A second SIGINT while the process ends (halrun's unloadusr and a
+    user's Ctrl-C together) arrives in the middle of the teardown: the
+    teardown still completes, without a traceback."""
+    host = hosts.make("ctrlc", "")
+    host.up()
+    code = textwrap.dedent("""\
+        import os, signal, time
+        import halsdk
+        import halsdk.core.instance as instance
+        c = halsdk.component("late")
+        c.newpin("out", "bit", "out")
+        c.ready()
+        real = instance._teardown
+        def teardown(conn):
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(0.2)    # the signal is handled before detach
+            real(conn)
+        instance._teardown = teardown
+    """)
+    proc = subprocess.run([sys.executable, "-c", code], cwd=tmp_path,
+                          env=host.env, capture_output=True, text=True,
+                          timeout=60)
+    assert proc.returncode == 0, proc.stderr
+    assert "Traceback" not in proc.stderr, proc.stderr
+    assert "late" not in host.halcmd("-s", "show", "comp").stdout
