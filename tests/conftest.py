@@ -18,7 +18,8 @@ TEST_COMPONENTS = ["tand2.pyx", "tcounter.pyx", "tlowpass.pyx", "cscale.c"]
 def _halsdk_segments() -> set[str]:
     """Instances of this session: their names carry the session's pid (the
     fixture's and the tests' private names do), so a second pytest session
-    running alongside is not counted."""
+    running alongside is not counted. Under pytest-xdist each worker checks
+    its own and hands what it found to the controller."""
     prefix = f"halsdk-{os.getuid()}"
     mark = f"-{os.getpid()}"
     return {n for n in os.listdir("/dev/shm")
@@ -26,16 +27,39 @@ def _halsdk_segments() -> set[str]:
 
 
 _before: set[str] = set()
+_left_by_workers: list[str] = []
 
 
 def pytest_sessionstart(session: pytest.Session) -> None:
     _before.update(_halsdk_segments())
 
 
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """The examples run whole machines in real time and check how closely
+    they follow: they are ``serial`` (CI runs them alone, after the rest
+    ran on two workers; see the README)."""
+    examples = os.path.join("tests", "examples") + os.sep
+    for item in items:
+        if examples in str(item.path):
+            item.add_marker(pytest.mark.serial)
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_testnodedown(node: object, error: object) -> None:
+    """pytest-xdist, in the controller: a worker's leftover instances."""
+    output = getattr(node, "workeroutput", {})
+    _left_by_workers.extend(output.get("halsdk_left", []))
+
+
 @pytest.hookimpl(trylast=True)
 def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
     """The suite ends by checking that no test left an instance behind."""
     left = sorted(_halsdk_segments() - _before)
+    workeroutput = getattr(session.config, "workeroutput", None)
+    if workeroutput is not None:        # an xdist worker: tell the controller
+        workeroutput["halsdk_left"] = left
+        return
+    left += _left_by_workers
     if left:
         print(f"\nFAILED: HAL instances left in /dev/shm: {', '.join(left)}")
         session.exitstatus = 1
