@@ -20,7 +20,7 @@ procedure, then the rest of the block.
   ``>`` for a feed above 0.
 * ``ngc=NAME``: ``NAME.ngc`` on the subroutine path, called as ``o<NAME>
   call``; inside it (and in what it calls) the remapped code itself runs
-  the built-in code.  ``#<_remap_level>`` is the nesting (at most 10).
+  the built-in code.  ``#<_remap_level>`` is the nesting (at most 9).
 * ``python=NAME``: ``remap.NAME(self, **words)`` of the ``[PYTHON]``
   plugin (:mod:`.pyplugin`); ``prolog=``/``epilog=`` are called around
   the NGC procedure, with its locals in scope.  A string returned is an
@@ -53,8 +53,8 @@ from .pyplugin import (
 )
 
 #: Remapped codes nested deeper than this are an error (the reference's
-#: limit).
-MAX_REMAP_LEVEL = 10
+#: limit: its 10 levels count the line that started them).
+MAX_REMAP_LEVEL = 9
 
 _ARGSPEC_LETTERS = set("abcdefhijklmnpqrstuvwxyz")
 _OPTIONS = ("modalgroup", "argspec", "ngc", "python", "py", "prolog",
@@ -206,6 +206,8 @@ class Remapper:
     plugin: Optional[Plugin] = None
     active: list[_Active] = field(default_factory=list)
     view: Optional[InterpreterView] = None
+    #: where ``ngc=`` procedures are (besides the running program's path)
+    search_path: tuple[str, ...] = ()
 
     @classmethod
     def from_ini(cls, ini: Any) -> Remapper:
@@ -477,7 +479,10 @@ def _child(interp: Any, text: str, file: str) -> Any:
     """A program of ``text`` run inside the one ``interp`` runs now."""
     from .program import Program
     parent = interp.program
-    search = getattr(parent, "search_path", ())
+    search = [*getattr(parent, "search_path", ())]
+    remapper = getattr(interp, "remap", None)
+    if remapper is not None:
+        search += [d for d in remapper.search_path if d not in search]
     child = Program(text, file, interp.params, search,
                     max_iterations=getattr(parent, "max_iterations",
                                            1_000_000),
@@ -569,6 +574,7 @@ def configure(interp: Any, ini: Any, search_path: Sequence[str] = ()
     :class:`~halsdk.ini.IniFile` ``ini`` (None when it has neither); the
     ``ngc=`` procedures must be files on ``search_path``."""
     remapper = Remapper.from_ini(ini)
+    remapper.search_path = tuple(search_path)
     for remap in remapper.remaps.values():
         if remap.ngc is not None and not any(
                 os.path.isfile(os.path.join(d, remap.ngc + ".ngc"))
