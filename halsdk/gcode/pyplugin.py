@@ -81,10 +81,15 @@ def python_failure(exc: BaseException, what: str, file: str, line: int,
                    column: int = 0) -> PluginError:
     """The error of Python code that raised ``exc`` while running G-code
     line ``file:line``."""
-    detail = "".join(traceback.format_exception_only(type(exc), exc)
-                     ).strip()
-    return PluginError(f"{what} raised {detail} (at {last_frame(exc)})",
-                       file, line, column)
+    if isinstance(exc, SyntaxError):
+        detail = f"{type(exc).__name__}: {exc.msg}"
+        frame = f"{exc.filename}:{exc.lineno}"
+    else:
+        detail = "".join(traceback.format_exception_only(type(exc), exc)
+                         ).strip()
+        frame = last_frame(exc)
+    return PluginError(f"{what} raised {detail} (at {frame})", file, line,
+                       column)
 
 
 # -- the stand-in modules ----------------------------------------------------
