@@ -1776,6 +1776,10 @@ class Interpreter:
         name = name.strip("<>").lower()
         if name.startswith("_ini[") and "]" in name:
             return self._ini_value(name)
+        if self.remap is not None:      # REMAP=, the [PYTHON] namedparams
+            found = self.remap.named_param(self, name)
+            if found is not None:
+                return found
         if name == "_remap_level":
             return float(self.remap.level if self.remap is not None else 0)
         if name.isdigit():              # #5420..#5428

@@ -236,6 +236,33 @@ class Remapper:
                                      remap.line)
         return remapper
 
+    # -- predefined parameters from Python -----------------------------
+    def named_param(self, interp: Any, name: str) -> Optional[float]:
+        """``#<_name>`` from the plugin's ``namedparams._name(self)``
+        (None: it has none); a string returned is an error message."""
+        plugin = self.plugin
+        if plugin is None or not name.startswith("_"):
+            return None
+        fn = plugin.function("namedparams", name)
+        if fn is None:
+            return None
+        view = self._view(interp)
+        what = f"#<{name}>: Python namedparams.{name}()"
+        try:
+            with plugin.running(view):
+                result = fn(view)
+        except GCodeError:
+            raise
+        except Exception as exc:
+            failure = python_failure(exc, what, "", 0)
+            raise GCodeError(failure.message) from None
+        if isinstance(result, str):
+            raise GCodeError(result)
+        if isinstance(result, (int, float)) and not isinstance(result, bool):
+            return float(result)
+        raise GCodeError(f"{what} returned {type(result).__name__}: it "
+                         "returns a number or an error message")
+
     # -- what runs --------------------------------------------------------
     @property
     def level(self) -> int:

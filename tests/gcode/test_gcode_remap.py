@@ -48,6 +48,7 @@ def setup(tmp_path: Path, remaps: str, files: dict[str, str],
 
 
 def run(interp: Interpreter, text: str, file: str = "p.ngc") -> None:
+    interp.ended = False            # (after the M2 of an earlier run)
     interp.run(Program(text, file, interp.params))
 
 
@@ -172,7 +173,15 @@ def test_no_ini_no_remap() -> None:
 
 # -- Python -------------------------------------------------------------------
 
-TOP = "import remap\nimport oword\n"
+TOP = "import remap\nimport oword\nimport namedparams\n"
+NAMED = """\
+def _twice_feed(self):
+    return 2 * self.feed_rate
+
+
+def _broken(self):
+    return {}["x"]
+"""
 REMAP = """\
 from interpreter import INTERP_OK, InterpreterException
 
@@ -211,7 +220,8 @@ def py(tmp_path: Path) -> tuple[Interpreter, C.RecordingCanon]:
     return setup(tmp_path, "REMAP=M401 argspec=Z python=lift\n"
                            "REMAP=M402 argspec=pq python=deep\n"
                            "REMAP=M403 python=catches",
-                 {"top.py": TOP, "remap.py": REMAP, "oword.py": OWORD},
+                 {"top.py": TOP, "remap.py": REMAP, "oword.py": OWORD,
+                  "namedparams.py": NAMED},
                  python=True)
 
 
@@ -288,3 +298,16 @@ def test_a_bad_plugin_names_the_ini_line(tmp_path: Path, top, why) -> None:
         files["top.py"] = top
     with pytest.raises(GCodeError, match=why):
         setup(tmp_path, "REMAP=M401 python=lift", files, python=True)
+
+
+def test_named_parameters_from_python(py, tmp_path: Path) -> None:
+    interp, rec = py
+    run(interp, "F7\nG0 X#<_twice_feed>\nM2\n")
+    assert traverses(rec) == [(14, 0, 0)]
+    with pytest.raises(GCodeError, match="p.ngc:1:.*read-only"):
+        run(interp, "#<_twice_feed> = 1\nM2\n")
+    with pytest.raises(GCodeError) as e:
+        run(interp, "G0 X1\nG0 X#<_broken>\nM2\n")
+    assert str(e.value).startswith("p.ngc:2:")
+    assert "namedparams._broken() raised KeyError: 'x' (at " \
+        f"{tmp_path / 'namedparams.py'}:6 in _broken)" in str(e.value)

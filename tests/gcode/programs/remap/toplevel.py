@@ -1,5 +1,6 @@
 # the [PYTHON]TOPLEVEL of the remap programs: it imports the modules the
 # interpreter looks in (written for halsdk's tests, not copied)
+import namedparams  # noqa: F401
 import oword  # noqa: F401
 import remap  # noqa: F401
 
