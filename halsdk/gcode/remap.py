@@ -310,11 +310,12 @@ class Remapper:
         try:
             if remap.python is not None:
                 # (a call level of its own, as an NGC procedure's)
+                depth = interp.params.depth
                 interp.params.push_scope()
                 try:
                     self._call(interp, remap, remap.python, words, block)
                 finally:
-                    interp.params.pop_scope()
+                    _close_scopes(interp.params, depth)
             else:
                 self._ngc(interp, block, remap, words)
         finally:
@@ -519,16 +520,27 @@ def _child(interp: Any, text: str, file: str) -> Any:
     return child
 
 
+def _close_scopes(params: Any, depth: int) -> None:
+    """Close the parameter scopes above ``depth`` (those of calls an
+    error left), with the method of the class (not a remap's hook)."""
+    while params.depth > depth:
+        type(params).pop_scope(params)
+
+
 def _drive(interp: Any, child: Any) -> None:
     """Execute the blocks of ``child`` with ``interp`` (as the program it
     runs, for the call level), then give it back its own."""
     parent = interp.program
+    depth = interp.params.depth
     interp.program = child
     try:
         for sub_block in child.subroutine_blocks():
             interp.execute(sub_block)
             if interp.ended:
                 break
+    except BaseException:
+        _close_scopes(interp.params, depth)
+        raise
     finally:
         interp.program = parent
 
@@ -587,8 +599,7 @@ def call_procedure(interp: Any, name: str, block: Block, key: str,
                 params.__dict__.pop(k, None)
             else:
                 params.__dict__[k] = hook
-        if held[0]:
-            plain_pop()
+        _close_scopes(params, depth)
 
 
 def block_code(block: Block, key: str) -> str:

@@ -311,3 +311,25 @@ def test_named_parameters_from_python(py, tmp_path: Path) -> None:
     assert str(e.value).startswith("p.ngc:2:")
     assert "namedparams._broken() raised KeyError: 'x' (at " \
         f"{tmp_path / 'namedparams.py'}:6 in _broken)" in str(e.value)
+
+
+def test_after_an_error_in_a_procedure_the_next_line_runs(tmp_path: Path
+                                                         ) -> None:
+    """rs274 -n 0 goes on after an error: the scopes the failed procedure
+    opened are closed and no remap stays in progress."""
+    import io
+
+    from halsdk.gcode.rs274 import run as rs274
+    (tmp_path / "bad.ngc").write_text(
+        "o<bad> sub\n#<local> = 1\no<inner> call\no<bad> endsub\n")
+    (tmp_path / "inner.ngc").write_text(
+        "o<inner> sub\nG1 X1 F-1\no<inner> endsub\n")
+    (tmp_path / "m.ini").write_text("[RS274NGC]\nREMAP=M400 ngc=bad\n")
+    out, err = io.StringIO(), io.StringIO()
+    status = rs274("#<top> = 5\nM400\nM400\n(debug, top=#<top>)\nM2\n",
+                   "p.ngc", out.write, err.write,
+                   ini=IniFile(str(tmp_path / "m.ini")),
+                   search_path=(str(tmp_path),), keep_going=True)
+    assert status == 0
+    assert err.getvalue().count("inner.ngc:2:") == 2
+    assert 'MESSAGE(" top=5.000000")' in out.getvalue()
