@@ -355,7 +355,11 @@ class Plugin:
             sys.path[:] = saved_path
 
     def function(self, module: str, name: str) -> Optional[Callable[..., Any]]:
-        """``module.name`` (``oword`` or ``remap``) if it is callable."""
+        """``module.name`` (``oword``, ``remap`` or ``namedparams``) if it
+        is callable; never a ``__dunder__`` attribute of the module (such
+        as ``__class__``)."""
+        if name.startswith("__") and name.endswith("__"):
+            return None
         mod = self.namespace.get(module)
         if not isinstance(mod, types.ModuleType):
             mod = self._modules.get(module)

@@ -260,6 +260,14 @@ def test_a_python_subroutine_may_return_an_int_not_a_list(py) -> None:
         run(interp, "o<alist> call\nM2\n")
 
 
+def test_only_the_functions_of_the_module_are_subroutines(py) -> None:
+    interp, _ = py
+    for name in ("__class__", "__loader__", "nosuch"):
+        with pytest.raises(GCodeError, match=f"unknown subroutine "
+                                             f"O<{name}>"):
+            run(interp, f"o<{name}> call\nM2\n")
+
+
 def test_the_plugin_stays_out_of_sys_modules_and_path(tmp_path: Path
                                                       ) -> None:
     """Two machines, each with its own remap.py: each calls its own; the
