@@ -341,3 +341,35 @@ def test_after_an_error_in_a_procedure_the_next_line_runs(tmp_path: Path
     assert status == 0
     assert err.getvalue().count("inner.ngc:2:") == 2
     assert 'MESSAGE(" top=5.000000")' in out.getvalue()
+
+
+def test_rs274_command_reports_without_a_traceback(tmp_path: Path) -> None:
+    """``rs274 -i``: Python that raises and a bad REMAP line are messages
+    and exit status 1, never a traceback."""
+    import subprocess
+    (tmp_path / "top.py").write_text("import remap\n")
+    (tmp_path / "remap.py").write_text(
+        "def boom(self, **words):\n    return 1 / 0\n")
+    ini = tmp_path / "m.ini"
+    ini.write_text("[RS274NGC]\nREMAP=M401 python=boom\n"
+                   "[PYTHON]\nTOPLEVEL = top.py\n")
+    prog = tmp_path / "p.ngc"
+    prog.write_text("G0 X1\nM401\nM2\n")
+    command = [sys.executable, "-m", "halsdk.gcode.rs274", "-g", "-i",
+               str(ini), str(prog)]
+    done = subprocess.run(command, capture_output=True, text=True,
+                          timeout=120, cwd=tmp_path)
+    assert done.returncode == 1
+    assert done.stderr.startswith(
+        f"{prog}:2:1: M401 remap: boom() raised ZeroDivisionError: "
+        f"division by zero (at {tmp_path / 'remap.py'}:2 in boom)\n")
+    assert "Traceback" not in done.stderr
+    assert "STRAIGHT_TRAVERSE(1.0000" in done.stdout
+    ini.write_text("[RS274NGC]\nREMAP=M401 python=boom argspec=O\n")
+    done = subprocess.run(command, capture_output=True, text=True,
+                          timeout=120, cwd=tmp_path)
+    assert (done.returncode, done.stdout) == (1, "")
+    assert done.stderr.startswith(f"{ini}:2:0: REMAP=M401 python=boom "
+                                  "argspec=O: argspec=O: letters O are not "
+                                  "allowed")
+    assert "Traceback" not in done.stderr
