@@ -34,7 +34,7 @@ from __future__ import annotations
 
 import inspect
 import os
-from collections.abc import Iterator, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any, Callable, Optional
 
@@ -303,7 +303,7 @@ class Remapper:
         if len(self.active) >= MAX_REMAP_LEVEL:
             raise block.error(f"remapped codes nested deeper than "
                               f"{MAX_REMAP_LEVEL} ({remap.name})",
-                              _column_key(remap, block))
+                              remap.code)
         interp.line = block.line
         interp.line_block = block
         self.active.append(_Active(remap, block))
@@ -331,7 +331,7 @@ class Remapper:
         if missing:
             raise block.error(f"user-defined {remap.name}: missing: "
                               f"{','.join(c.upper() for c in missing)}",
-                              _column_key(remap, block))
+                              remap.code)
         problems = []
         if ">" in spec and not interp.feed_value > 0:
             problems.append("a feed above 0 (F)")
@@ -340,7 +340,7 @@ class Remapper:
         if problems:
             raise block.error(f"user-defined {remap.name} needs "
                               f"{' and '.join(problems)}",
-                              _column_key(remap, block))
+                              remap.code)
         words = {c: float(block.words[c]) for c in remap.words
                  if c in block.words}
         if "n" in spec:
@@ -362,7 +362,7 @@ class Remapper:
         fn = self.plugin.function("remap", name)
         if fn is None:          # (checked when the INI file was read)
             raise block.error(f"no Python function remap.{name}",
-                              _column_key(remap, block))
+                              remap.code)
         view = self._view(interp)
         what = f"{remap.name} remap: {name}()"
         try:
@@ -382,9 +382,9 @@ class Remapper:
             raise
         except Exception as exc:
             raise python_failure(exc, what, block.file, block.line,
-                                 block.column_of(_column_key(remap, block))
+                                 block.column_of(remap.code)
                                  ) from None
-        _check_result(result, what, block, _column_key(remap, block))
+        _check_result(result, what, block, remap.code)
 
     def _ngc(self, interp: Any, block: Block, remap: Remap,
              words: dict[str, float]) -> None:
@@ -416,7 +416,7 @@ class Remapper:
                 self._call(interp, remap, remap.epilog, words, block)
 
         assert remap.ngc is not None
-        call_procedure(interp, remap.ngc, block, _column_key(remap, block),
+        call_procedure(interp, remap.ngc, block, remap.code,
                        prolog, epilog)
 
 
@@ -432,10 +432,6 @@ def _check_result(result: Any, what: str, block: Block, key: str) -> None:
     raise block.error(f"{what} returned {type(result).__name__}: it "
                       "returns INTERP_OK (or nothing) or an error message",
                       key)
-
-
-def _column_key(remap: Remap, block: Block) -> str:
-    return remap.code
 
 
 def _step_of_g(value: float) -> int:
@@ -590,7 +586,7 @@ def call_procedure(interp: Any, name: str, block: Block, key: str,
             epilog()
     except GCodeError as exc:
         if exc.file == label:   # the call itself: unknown procedure ...
-            raise block.error(f"{block_code(block, key)}: {exc.message}",
+            raise block.error(f"{key.upper()}: {exc.message}",
                               key) from None
         raise
     finally:
@@ -600,10 +596,6 @@ def call_procedure(interp: Any, name: str, block: Block, key: str,
             else:
                 params.__dict__[k] = hook
         _close_scopes(params, depth)
-
-
-def block_code(block: Block, key: str) -> str:
-    return key.upper()
 
 
 def configure(interp: Any, ini: Any, search_path: Sequence[str] = ()
@@ -664,12 +656,6 @@ def python_sub(interp: Any, name: str
                          "returns nothing, a number or an error message",
                          file, line, column)
     return call
-
-
-def iter_remaps(remapper: Optional[Remapper]) -> Iterator[Remap]:
-    """The remapped codes (for documentation and tests)."""
-    if remapper is not None:
-        yield from remapper.remaps.values()
 
 
 __all__ = ["MAX_REMAP_LEVEL", "Remap", "RemapError", "Remapper",
