@@ -159,8 +159,10 @@ class Interpreter:
         self._previous_motion = 10
         self._sync: Optional[float] = None      # G76: pitch being synced
         self._spline_pq = (0.0, 0.0)            # G5: the last P, Q
+        #: REMAP= codes and the [PYTHON] plugin (halsdk.gcode.remap)
+        self.remap: Any = None
         #: the program being run (for M73: its call level)
-        self.program: Any = None
+        self._program: Any = None
         #: M70 state and the M73 state with its call level
         self._saved: Optional[dict[str, Any]] = None
         self._autosaved: list[tuple[int, dict[str, Any]]] = []
@@ -301,6 +303,19 @@ class Interpreter:
         return _DEBUG_PARAM.sub(one, text)
 
     # -- public API ------------------------------------------------------
+    @property
+    def program(self) -> Any:
+        """The program being run (its ``o<name> call`` finds the Python
+        subroutines of the interpreter's plugin)."""
+        return self._program
+
+    @program.setter
+    def program(self, program: Any) -> None:
+        self._program = program
+        if self.remap is not None and program is not None:
+            from .remap import python_sub
+            program.python_subs = lambda name: python_sub(self, name)
+
     def run(self, program: Any) -> None:
         """Execute every block of ``program`` until it ends."""
         self.program = program
@@ -315,6 +330,11 @@ class Interpreter:
         # plain moves (most blocks of a CAM program) take a short path,
         # compiled: it does what this method, _target, _straight_feed and
         # _traverse do for them, so a change to those belongs there too
+        if self.remap is not None:
+            remap = self.remap.first(block)
+            if remap is not None:       # REMAP= code (halsdk.gcode.remap)
+                self.remap.execute(self, block, remap)
+                return
         if self._fast_ready(block) and fast_move(self, block):
             return
         self._execute(block)
@@ -1756,6 +1776,12 @@ class Interpreter:
         name = name.strip("<>").lower()
         if name.startswith("_ini[") and "]" in name:
             return self._ini_value(name)
+        if self.remap is not None:      # REMAP=, the [PYTHON] namedparams
+            found = self.remap.named_param(self, name)
+            if found is not None:
+                return found
+        if name == "_remap_level":
+            return float(self.remap.level if self.remap is not None else 0)
         if name.isdigit():              # #5420..#5428
             i = int(name) - 5420
             return self.program_position()[i] / self._k(i)

@@ -480,6 +480,12 @@ class Program:
         self._frames: list[_Frame] = []
         self._main = _Unit.from_text(text, file)
         self._files: dict[str, _Unit] = {}
+        #: ``python_subs(name)``: a Python subroutine for ``o<name> call``
+        #: (``f(args, file, line, column)`` -> the value returned or None),
+        #: looked for before the NGC ones; set by the interpreter that has
+        #: a ``[PYTHON]`` plugin (see :mod:`halsdk.gcode.remap`)
+        self.python_subs: Optional[Callable[[str], Optional[Callable[
+            [list[float], str, int, int], Optional[float]]]]] = None
 
     @classmethod
     def from_file(cls, path: str, params: Parameters | None = None,
@@ -604,6 +610,18 @@ class Program:
             for unit in self._files.values():
                 unit.close()
 
+    def subroutine_blocks(self) -> Iterator[Block]:
+        """:meth:`blocks` for a program run inside another one (a remapped
+        code's procedure, G-code run by Python): the parameter scopes of
+        the running program are left as they are."""
+        self.iterations = 0
+        self._idle_since = self.clock()
+        yield from self._run()
+
+    def share_files(self, other: Program) -> None:
+        """Use the subroutine files ``other`` has read (and read more)."""
+        self._files = other._files
+
     def _run(self) -> Iterator[Block]:
         unit = self._main
         index = 0
@@ -681,6 +699,12 @@ class Program:
             if keyword == "call":
                 name = oword.name if isinstance(oword.name, str) else \
                     f"{self._value(oword.name, line):g}"
+                python = self.python_subs(name) if self.python_subs \
+                    else None
+                if python is not None:
+                    self._python_call(python, oword, line)
+                    index += 1
+                    continue
                 target = self._find_sub(name, unit)
                 if target is None:
                     raise GCodeError(f"unknown subroutine {_label(name)}",
@@ -773,6 +797,18 @@ class Program:
             else:  # pragma: no cover - the lexer admits no other keyword
                 raise GCodeError(f"unsupported o-word {keyword}", line.file,
                                  line.number, oword.column)
+
+    def _python_call(self, python: Callable[[list[float], str, int, int],
+                                            Optional[float]],
+                     oword: OWord, line: Line) -> None:
+        """``o<name> call`` of a Python subroutine: its value returned in
+        ``#<_value>`` (and ``#<_value_returned>`` 1), as an NGC one's."""
+        args = [self._value(a, line) for a in oword.args]
+        self.params.set("_value_returned", 0.0)
+        returned = python(args, line.file, line.number, oword.column)
+        if returned is not None:
+            self.params.set("_value", returned)
+            self.params.set("_value_returned", 1.0)
 
     def _count(self, unit: _Unit, index: int, what: str) -> None:
         """Count one more loop iteration or subroutine call of this run

@@ -17,7 +17,7 @@ from __future__ import annotations
 import argparse
 import os
 import sys
-from typing import IO, Any, Callable, Optional
+from typing import IO, Any, Callable, Optional, Union
 
 from halsdk import console
 from halsdk.ini import IniFile
@@ -59,9 +59,10 @@ def _parser() -> argparse.ArgumentParser:
                         "written back at the end (default: none, every "
                         "parameter starts at 0)")
     p.add_argument("-i", metavar="file.ini",
-                   help="INI file: [RS274NGC]PARAMETER_FILE (unless -v) and "
-                        "SUBROUTINE_PATH are read, and #<_ini[SECTION]KEY> "
-                        "reads its numeric values")
+                   help="INI file: [RS274NGC]PARAMETER_FILE (unless -v), "
+                        "SUBROUTINE_PATH and REMAP lines and the [PYTHON] "
+                        "plugin are used, and #<_ini[SECTION]KEY> reads its "
+                        "numeric values")
     p.add_argument("-n", type=int, choices=(0, 1, 2), default=2,
                    help="what to do after an error: 2 stop (default), 0 "
                         "report it and go on with the next line; 1 (MDI "
@@ -104,13 +105,16 @@ def run(text: str, file: str, write: Callable[[str], Any],
         error: Callable[[str], Any], *, tool_file: Optional[str] = None,
         var_file: Optional[str] = None, block_delete: bool = False,
         search_path: tuple[str, ...] = (),
-        ini: Optional[Callable[[str, str], Optional[str]]] = None,
+        ini: Union[IniFile, Callable[[str, str], Optional[str]],
+                   None] = None,
         keep_going: bool = False) -> int:
     """Interpret ``text`` and ``write`` the reference's lines; errors go to
     ``error``.  The exit status: 0, or 1 after an error.  With
     ``keep_going`` (``-n 0``) a line the interpreter refuses is reported
     and skipped, and the status stays 0; an error in reading the program
-    still ends it."""
+    still ends it.  ``ini`` is an :class:`IniFile` (its ``REMAP=`` lines
+    and ``[PYTHON]`` plugin are used, see :mod:`.remap`) or a lookup
+    ``ini(SECTION, KEY)``."""
     from halsdk.machine.tooltable import ToolTable, ToolTableError
 
     try:
@@ -130,9 +134,20 @@ def run(text: str, file: str, write: Callable[[str], Any],
         params.set(5220, 1.0)
     canon = TextCanon(write)
     status = 0
+    ini_file = ini if isinstance(ini, IniFile) else None
+    lookup: Optional[Callable[[str, str], Optional[str]]] = (
+        ini_file.get if ini_file is not None
+        else ini if not isinstance(ini, IniFile) else None)
     interp = Interpreter(params, tools, canon, units="inch",
-                         program_units="mm", ini=ini)
+                         program_units="mm", ini=lookup)
     canon.interp = interp
+    if ini_file is not None:
+        from .remap import configure
+        try:
+            configure(interp, ini_file, search_path)
+        except GCodeError as exc:       # (the reference prints nothing)
+            error(f"{exc}\n")
+            return 1
     canon.start()
     def report(exc: GCodeError) -> None:
         error(f"{exc}\n")
@@ -164,7 +179,7 @@ def run(text: str, file: str, write: Callable[[str], Any],
         report(exc)
         status = 1
     canon.call("ON_RESET()")
-    if ini is None:             # (the reference prints one less with -i)
+    if lookup is None:          # (the reference prints one less with -i)
         canon.call("ON_RESET()")
     if var_file:
         try:
@@ -222,7 +237,7 @@ def _main(argv: Optional[list[str]] = None) -> int:
     try:
         return run(text, name, out.write, sys.stderr.write,
                    tool_file=a.t, var_file=var_file, block_delete=a.b,
-                   search_path=search, ini=None if ini is None else ini.get,
+                   search_path=search, ini=ini,
                    keep_going=a.n == 0)
     finally:
         if out is not sys.stdout:

@@ -71,6 +71,7 @@ from halsdk.gcode import GCodeError, Parameters, Program
 from halsdk.gcode.cutter_radius import CutterComp
 from halsdk.gcode.interp import Interpreter
 from halsdk.gcode.program import MAX_IDLE_TIME, MAX_ITERATIONS
+from halsdk.gcode.remap import configure as configure_remap
 from halsdk.machine.executor import Executor
 from halsdk.machine.iocontrol import IoControl
 from halsdk.machine.snapshot import build_snapshot
@@ -236,6 +237,13 @@ class TaskController:
             ini, "HALSDK_MAX_ITERATIONS", self.max_iterations, True))
         self.max_idle_time = _ini_limit(
             ini, "HALSDK_MAX_IDLE_TIME", self.max_idle_time, False)
+        # REMAP= lines and the [PYTHON] plugin (halsdk.gcode.remap): kept
+        # for the interpreters made after a reset
+        try:
+            self._remap = configure_remap(self.interp, ini,
+                                          self.subroutine_path)
+        except GCodeError as exc:
+            raise MachineError(str(exc)) from None
         name = ini.get("RS274NGC", "PARAMETER_FILE")
         if name:
             self.parameter_file = os.path.join(folder, name)
@@ -256,6 +264,7 @@ class TaskController:
                              units=self.units,
                              ini=getattr(self, "ini_lookup", None))
         interp.pos = list(self.executor.pos)
+        interp.remap = getattr(self, "_remap", None)
         self.executor.interp = interp
         return interp
 

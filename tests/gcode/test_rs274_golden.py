@@ -89,7 +89,7 @@ def ours(prog: Path, tmp_path: Path) -> tuple[str, int]:
     status = run(prog.read_text(encoding="utf-8"), str(prog), out.write,
                  err.write, tool_file=str(tbl) if tbl.exists() else None,
                  var_file=var_file, search_path=(str(prog.parent),),
-                 ini=IniFile(str(ini)).get if ini.exists() else None,
+                 ini=IniFile(str(ini)) if ini.exists() else None,
                  block_delete="-b" in options,
                  keep_going="-n 0" in " ".join(options))
     return out.getvalue(), status

@@ -476,3 +476,55 @@ def test_m66_waits_for_an_edge_while_the_machine_runs(machine, hal,
     m.abort()
     assert m.status().interp_state is InterpState.IDLE
     assert list(m.executor.pending) == []
+
+
+def test_remapped_codes_of_the_ini_run_on_the_machine(machine, tmp_path):
+    """REMAP= lines and the [PYTHON] plugin of the machine's INI file:
+    an M code done by an NGC procedure (from MDI and in a program), one
+    done by Python, and o<name> call of a Python subroutine."""
+    from halsdk.ini import IniFile
+    m = machine
+    (tmp_path / "sub").mkdir()
+    (tmp_path / "sub" / "goto.ngc").write_text(
+        "o<goto> sub\nG0 X#<p> Y[#<p> / 2]\no<goto> endsub\nM2\n")
+    (tmp_path / "top.py").write_text("import remap\nimport oword\n")
+    (tmp_path / "remap.py").write_text(
+        "def lift(self, **words):\n"
+        "    self.execute('G0 Z%f' % words['z'])\n")
+    (tmp_path / "oword.py").write_text(
+        "def half(self, a):\n    return a / 2\n")
+    ini = tmp_path / "machine.ini"
+    ini.write_text("[RS274NGC]\nSUBROUTINE_PATH = sub\n"
+                   "REMAP=M400 modalgroup=10 argspec=P ngc=goto\n"
+                   "REMAP=M401 argspec=Z python=lift\n"
+                   "[PYTHON]\nTOPLEVEL = top.py\nPATH_APPEND = .\n")
+    m.configure_from_ini(IniFile(str(ini)))
+    turn_on(m)
+    m.mode(TaskMode.MDI)
+    m.mdi("G21 G90")
+    m.mdi("M400 P8")
+    assert m.status().position[:2] == pytest.approx((8, 4))
+    m.mdi("M401 Z3")
+    assert m.status().position[2] == pytest.approx(3)
+    path = tmp_path / "p.ngc"
+    path.write_text("G21 G90\no<half> call [10]\nM400 P#<_value>\n"
+                    "M401 Z1\nM2\n")
+    m.mode(TaskMode.AUTO)
+    m.program_open(str(path))
+    m.program_run()
+    m.wait_program(timeout=10)
+    assert m.status().position[:3] == pytest.approx((5, 2.5, 1))
+    m.mode(TaskMode.MDI)
+    with pytest.raises(MachineError, match="<mdi>:1:1: user-defined M401: "
+                                           "missing: Z"):
+        m.mdi("M401")                   # Z is required
+
+
+def test_a_bad_remap_line_names_the_ini_line(machine, tmp_path):
+    from halsdk.ini import IniFile
+    ini = tmp_path / "bad.ini"
+    ini.write_text("[RS274NGC]\n\nREMAP=M400 ngc=x python=y\n")
+    with pytest.raises(MachineError,
+                       match=r"bad.ini:3:0: REMAP=M400 ngc=x python=y: "
+                             "ngc= and python= exclude each other"):
+        machine.configure_from_ini(IniFile(str(ini)))

@@ -11,7 +11,9 @@ interpreter, ``reference rs274 -g prog.ngc``, in a fresh folder under
 they exist (``NAME.args`` holds more options, ``-b`` or ``-n 0``), and of
 the library
 files of the group (``.ngc`` files whose first line starts with
-``o<``: subroutine files, not programs). It writes next to the program:
+``o<``: subroutine files and REMAP procedures, not programs) and of its
+``.py`` files (the ``[PYTHON]`` plugin of REMAP programs). It writes next
+to the program:
 
 * ``NAME.out``: the standard output (the golden data compared byte for
   byte by tests/gcode/test_rs274_golden.py);
@@ -74,6 +76,9 @@ def run_one(prog: Path, reference: str) -> int:
         for lib in prog.parent.glob("*.ngc"):
             if lib != prog and is_library(lib):
                 shutil.copy(lib, work / lib.name)
+        for module in prog.parent.glob("*.py"):
+            # the [PYTHON] plugin files of the group's INI files
+            shutil.copy(module, work / module.name)
         for f in work.iterdir():
             os.chmod(f, 0o644)
         extra = prog.with_suffix(".args")
