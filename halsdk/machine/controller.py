@@ -124,6 +124,15 @@ class _Job:
         self.error: Optional[str] = None
 
 
+def subroutine_path(ini: Any) -> list[str]:
+    """[RS274NGC]SUBROUTINE_PATH of ``ini``: its folders (``:`` between
+    them), relative to the INI file's folder."""
+    folder = os.path.dirname(os.path.abspath(ini.path))
+    paths = ini.get("RS274NGC", "SUBROUTINE_PATH")
+    return [os.path.join(folder, p.strip())
+            for p in str(paths or "").split(":") if p.strip()]
+
+
 def _ini_limit(ini: Any, key: str, default: float, whole: bool) -> float:
     """The halsdk-specific [RS274NGC]key: a number above 0 (a whole one
     when ``whole``); ``default`` when the key is absent."""
@@ -228,11 +237,7 @@ class TaskController:
             self.axis_mask = sum(1 << "XYZABCUVW".index(c)
                                  for c in set(letters))
         folder = os.path.dirname(self.ini_filename)
-        paths = ini.get("RS274NGC", "SUBROUTINE_PATH")
-        if paths:
-            self.subroutine_path = [
-                os.path.join(folder, p.strip()) for p in paths.split(":")
-                if p.strip()]
+        self.subroutine_path = subroutine_path(ini) or self.subroutine_path
         self.max_iterations = int(_ini_limit(
             ini, "HALSDK_MAX_ITERATIONS", self.max_iterations, True))
         self.max_idle_time = _ini_limit(

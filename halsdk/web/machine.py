@@ -154,7 +154,9 @@ def make_preview(path: str, st: Optional[RemoteStatus]) -> dict[str, Any]:
     from halsdk.gcode import GCodeError, Parameters, Program
     from halsdk.gcode import canon as C
     from halsdk.gcode.interp import Interpreter
+    from halsdk.gcode.remap import configure as configure_remap
     from halsdk.machine import ToolTable
+    from halsdk.machine.controller import subroutine_path
 
     class Recorder(C.RecordingCanon):
         def emit(self, command: C.Command) -> None:
@@ -166,10 +168,11 @@ def make_preview(path: str, st: Optional[RemoteStatus]) -> dict[str, Any]:
     table: Any = ToolTable()
     units = "mm"
     start = (0.0, 0.0)
+    ini: Any = None
     if st is not None:
         start = (float(st.position[0]), float(st.position[1]))
         if st.ini_filename:
-            table, units = _machine_files(st.ini_filename, params)
+            table, units, ini = _machine_files(st.ini_filename, params)
         index = min(max(int(st.g5x_index or 1), 1), 9)
         params.set(5220, index)
         for i in range(9):
@@ -183,7 +186,14 @@ def make_preview(path: str, st: Optional[RemoteStatus]) -> dict[str, Any]:
                              random_toolchanger=table.random, units=units)
         if st is not None:
             interp.pos = [float(v) for v in st.position[:9]]
-        interp.run(Program.from_file(path, params))
+        search: list[str] = []
+        if ini is not None:
+            # as the machine reads its programs: the subroutine path,
+            # #<_ini[...]>, the REMAPs and the [PYTHON] plugin
+            search = subroutine_path(ini)
+            interp.ini = ini.get
+            configure_remap(interp, ini, search)
+        interp.run(Program.from_file(path, params, search))
     except _TooLong:
         error = (f"the preview shows the first {MAX_PREVIEW_MOVES} moves "
                  "only")
@@ -193,15 +203,16 @@ def make_preview(path: str, st: Optional[RemoteStatus]) -> dict[str, Any]:
             "error": error}
 
 
-def _machine_files(ini_path: str, params: Any) -> tuple[Any, str]:
-    """The tool table and the units of the machine's INI file; its
-    parameter file into ``params`` (what can be read of them)."""
+def _machine_files(ini_path: str, params: Any) -> tuple[Any, str, Any]:
+    """The tool table, the units and the INI file (None if unreadable)
+    of the machine; its parameter file into ``params`` (what can be read
+    of them)."""
     from halsdk.ini import IniFile
     from halsdk.machine import ToolTable
     try:
         ini = IniFile(ini_path)
     except (OSError, HalError):
-        return ToolTable(), "mm"
+        return ToolTable(), "mm", None
     folder = os.path.dirname(os.path.abspath(ini_path))
     random = str(ini.get("EMCIO", "RANDOM_TOOLCHANGER") or "0"
                  ).strip() not in ("0", "")
@@ -217,7 +228,7 @@ def _machine_files(ini_path: str, params: Any) -> tuple[Any, str]:
             file = os.path.join(folder, str(name))
             if os.path.exists(file):
                 params.load(file)
-    return table, _ini_units(ini)
+    return table, _ini_units(ini), ini
 
 
 # ----------------------------------------------------------------- status

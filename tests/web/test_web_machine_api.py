@@ -300,3 +300,33 @@ def test_preview_paths_join_moves_of_one_kind():
     assert paths[1]["points"][-2:] == [2, 3]
     # a counter-clockwise half circle from (2, 1) around (2, 2): x > 2
     assert max(paths[1]["points"][4::2]) > 2.9
+
+
+def test_the_preview_reads_programs_as_the_machine_does(tmp_path):
+    """The preview uses the machine's [RS274NGC] settings: subroutines on
+    SUBROUTINE_PATH, REMAPped codes and #<_ini[...]> values."""
+    from types import SimpleNamespace
+    (tmp_path / "subs").mkdir()
+    (tmp_path / "subs" / "square.ngc").write_text(
+        "o<square> sub\nG1 X#1 F100\nG1 Y#1\no<square> endsub\nM2\n")
+    (tmp_path / "subs" / "m400.ngc").write_text(
+        "o<m400> sub\nG0 X-#<p>\no<m400> endsub\nM2\n")
+    ini = tmp_path / "m.ini"
+    ini.write_text("[TRAJ]\nLINEAR_UNITS = mm\n[RS274NGC]\n"
+                   "SUBROUTINE_PATH = subs\n"
+                   "REMAP = M400 modalgroup=10 argspec=P ngc=m400\n"
+                   "[PART]\nSIZE = 12\n")
+    prog = tmp_path / "p.ngc"
+    prog.write_text("G21 G90\no<square> call [#<_ini[part]size>]\n"
+                    "M400 P3\nM2\n")
+    st = SimpleNamespace(position=(0.0,) * 9, ini_filename=str(ini),
+                         g5x_index=1, g5x_offset=(0.0,) * 9,
+                         g92_offset=(0.0,) * 9)
+    preview = page.make_preview(str(prog), st)
+    assert preview["error"] == ""
+    points = [(x, y) for p in preview["paths"]
+              for x, y in zip(p["points"][0::2], p["points"][1::2])]
+    assert (12, 0) in points and (12, 12) in points and (-3, 12) in points
+    # without the machine's INI file the same program is an error
+    st.ini_filename = ""
+    assert "square" in page.make_preview(str(prog), st)["error"]
