@@ -156,6 +156,13 @@ class Interpreter:
         self.selected_tool = -1
         self.selected_pocket = -1
         self.diameter_mode = False
+        #: #<_task>: 1 when the interpreter runs a machine's programs (the
+        #: task controller sets it), 0 for rs274 and previews
+        self.task = False
+        #: M48-M53 (rs274): feed and speed override, adaptive feed and
+        #: feed hold enabled
+        self.override_enables = {"feed": True, "speed": True,
+                                 "adaptive": False, "hold": True}
         self._previous_motion = 10
         self._sync: Optional[float] = None      # G76: pitch being synced
         self._spline_pq = (0.0, 0.0)            # G5: the last P, Q
@@ -365,6 +372,8 @@ class Interpreter:
             self._comment_trace(block)
         elif block.message:
             self._emit(C.Message(block.message, line))
+        if 14 in gs:
+            self._spindle_mode(block, gs[14])
         if 5 in gs:
             self._feed_mode(block, gs[5])
         if "f" in block.words:
@@ -425,6 +434,17 @@ class Interpreter:
             self.modal.units = gs[6]
             self._trace("USE_LENGTH_UNITS(CANON_UNITS_"
                         f"{'MM' if gs[6] == 210 else 'INCHES'})")
+        if 15 in gs:
+            if not ref:
+                raise block.error(f"G{gs[15] // 10} (lathe diameter/radius "
+                                  "mode) is not supported",
+                                  code_key("g", gs[15] / 10))
+            diameter = gs[15] == 70
+            if diameter != self.diameter_mode:
+                self._trace('COMMENT("interpreter: Lathe diameter mode '
+                            f'changed to {"diameter" if diameter else "radius"}'
+                            '")')
+            self.diameter_mode = diameter
         if 7 in gs:
             self._cutter_comp(block, gs[7])
         if 8 in gs:
@@ -459,17 +479,6 @@ class Interpreter:
             self.modal.retract = gs[10]
             self._trace('COMMENT("interpreter: retract mode set to '
                         f'{"old_z" if gs[10] == 980 else "r_plane"}")')
-        if 15 in gs:
-            if not ref:
-                raise block.error(f"G{gs[15] // 10} (lathe diameter/radius "
-                                  "mode) is not supported",
-                                  code_key("g", gs[15] / 10))
-            diameter = gs[15] == 70
-            if diameter != self.diameter_mode:
-                self._trace('COMMENT("interpreter: Lathe diameter mode '
-                            f'changed to {"diameter" if diameter else "radius"}'
-                            '")')
-            self.diameter_mode = diameter
         g0 = gs.get(0)
         if g0 in (100,):
             self._g10(block)
@@ -621,12 +630,35 @@ class Interpreter:
         if "q" in words:
             self._trace(f"SPINDLE.0.WAIT_ORIENT_COMPLETE({words['q']:.4f})")
 
+    def _spindle_mode(self, block: Block, code: int) -> None:
+        """G96 (constant surface speed, up to D rpm; rs274 only: a
+        machine's spindle has no such mode yet) and G97 (rpm)."""
+        if block.words.get("s", 0.0) < 0:
+            return                      # the S word's error comes next
+        if code == 960:
+            if not self.ref:
+                raise block.error("G96 (constant surface speed) is not "
+                                  "supported", "g96")
+            if "s" not in block.words:
+                raise block.error("S word missing with G96", "g96")
+            limit = abs(block.words.get("d", 1e30))
+            self._trace(f"SET_SPINDLE_MODE(0 {limit:.4f})")
+        else:
+            self._trace("SET_SPINDLE_MODE(0 0.0000)")
+        self.modal.spindle_mode = code
+
     def _overrides(self, block: Block, code: int) -> None:
         key = code_key("m", code / 10)
         if not self.ref:
             raise block.error(f"M{code // 10} (override control) is not "
                               "supported", key)
         on = block.words.get("p", 1.0) != 0
+        enables = self.override_enables
+        if code in (480, 490):
+            enables["feed"] = enables["speed"] = code == 480
+        else:
+            enables[{500: "feed", 510: "speed", 520: "adaptive",
+                     530: "hold"}[code]] = on
         if code == 480:
             self._trace("ENABLE_FEED_OVERRIDE()")
             self._trace("ENABLE_SPEED_OVERRIDE(0)")
@@ -740,7 +772,7 @@ class Interpreter:
             allowed.add("h")
         if gs.get(13) == 640:
             allowed |= set("pq")
-        if 7 in gs:
+        if 7 in gs or gs.get(14) == 960:
             allowed.add("d")
         if 5 in ms:
             allowed |= set("pelq")
@@ -753,6 +785,15 @@ class Interpreter:
         return allowed
 
     # -- tools -----------------------------------------------------------
+    def current_pocket(self) -> int:
+        """``#<_current_pocket>``: the pocket the tool in the spindle came
+        from (0: no tool, or a tool not in the table)."""
+        tool = self.current_tool
+        if tool <= 0 or not self.tools:
+            return 0
+        pocket = self.tools.pocket_of(tool)
+        return 0 if pocket is None else int(pocket)
+
     def _tool_of(self, tool: int) -> Any:
         """The tool table entry of ``tool`` or None for 'no tool'."""
         if tool < 0 or (tool == 0 and not self.random):
@@ -1037,9 +1078,13 @@ class Interpreter:
         self._trace("SET_FEED_MODE(0, 0)")
         self._trace("SET_FEED_RATE(0.0000)")
         self.feed = self.feed_value = 0.0
+        if not self.override_enables["feed"]:   # M2 turns it on again
+            self.override_enables["feed"] = True
+            self._trace("ENABLE_FEED_OVERRIDE()")
         m.spindle = 50
         self._emit(C.SpindleOff(line))
         self._trace("SET_SPINDLE_MODE(0 0.0000)")
+        m.spindle_mode = 970
         if m.mist:
             self._trace("MIST_OFF()")
         if m.flood:
@@ -1788,6 +1833,9 @@ class Interpreter:
         if len(name) == 2 and name[1] in AXES:
             i = AXES.index(name[1])
             return self.program_position()[i] / self._k(i)
+        if name.startswith("_abs_") and len(name) == 6 and name[5] in "xyzabc":
+            i = AXES.index(name[5])     # machine coordinates, program units
+            return self.pos[i] / self._k(i)
         value = _PREDEFINED.get(name)
         return None if value is None else value(self, self.modal)
 
@@ -1818,4 +1866,21 @@ _PREDEFINED: dict[str, Callable[[Interpreter, ModalState], float]] = {
     "_selected_tool": lambda i, m: float(i.selected_tool),
     "_selected_pocket": lambda i, m: float(i.selected_pocket),
     "_line": lambda i, m: float(i.line),
+    # the LinuxCNC version whose language this is (2.9.0)
+    "_vmajor": lambda i, m: 2.9,
+    "_vminor": lambda i, m: 0.0,
+    "_task": lambda i, m: float(i.task),
+    "_call_level": lambda i, m: float(
+        i.program.call_level if i.program is not None else 0),
+    "_units_per_rev": lambda i, m: float(m.feed_mode == 950),
+    "_spindle_rpm_mode": lambda i, m: float(m.spindle_mode == 970),
+    "_spindle_css_mode": lambda i, m: float(m.spindle_mode == 960),
+    "_ijk_absolute_mode": lambda i, m: float(m.arc_distance == 901),
+    "_lathe_diameter_mode": lambda i, m: float(i.diameter_mode),
+    "_lathe_radius_mode": lambda i, m: float(not i.diameter_mode),
+    "_feed_override": lambda i, m: float(i.override_enables["feed"]),
+    "_speed_override": lambda i, m: float(i.override_enables["speed"]),
+    "_adaptive_feed": lambda i, m: float(i.override_enables["adaptive"]),
+    "_feed_hold": lambda i, m: float(i.override_enables["hold"]),
+    "_current_pocket": lambda i, m: float(i.current_pocket()),
 }

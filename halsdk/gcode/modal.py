@@ -32,6 +32,7 @@ G_GROUPS: dict[int, tuple[int, ...]] = {
     10: (980, 990),
     12: (540, 550, 560, 570, 580, 590, 591, 592, 593),
     13: (610, 611, 640),
+    14: (960, 970),
     15: (70, 80),
 }
 M_GROUPS: dict[int, tuple[int, ...]] = {
@@ -95,6 +96,7 @@ class ModalState:
     coord_system: int = 540
     control: int = 640
     spindle: int = 50           # M5
+    spindle_mode: int = 970     # G97 (G96: constant surface speed)
     mist: bool = False
     flood: bool = False
 

@@ -269,6 +269,7 @@ class TaskController:
                              units=self.units,
                              ini=getattr(self, "ini_lookup", None))
         interp.pos = list(self.executor.pos)
+        interp.task = True              # #<_task>: the machine's interpreter
         interp.remap = getattr(self, "_remap", None)
         self.executor.interp = interp
         return interp

@@ -703,3 +703,16 @@ def test_tool_and_position_parameters_are_read_only():
         assert "read-only" in str(err(f"#{number} = 1\n"))
     interp, _ = run("#5399 = 2\n#5429 = 3\nT1 M6\n")
     assert interp.params.get(5429) == 3 and interp.params.get(5400) == 1
+
+
+def test_spindle_modes_on_a_machine_and_the_predefined_names():
+    """A machine's interpreter runs G97 (its only spindle mode) and
+    refuses G96; the predefined names read the modal state."""
+    interp, rec = run("G21 G97 S500 M3\n#1 = #<_spindle_rpm_mode>\n"
+                      "#2 = #<_spindle_css_mode>\n#3 = #<_task>\n"
+                      "G0 X3 Y4\n#4 = #<_abs_x>\nG20\n#5 = #<_abs_y>\n"
+                      "T2 M6\n#6 = #<_current_pocket>\nM2\n")
+    values = [interp.params.get(i) for i in range(1, 7)]
+    assert values == [1.0, 0.0, 0.0, 3.0, pytest.approx(4 / 25.4), 2.0]
+    e = err("G21 G96 S100 D2000 M3\nM2\n")
+    assert e.line == 1 and "G96" in str(e)

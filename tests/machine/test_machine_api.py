@@ -528,3 +528,17 @@ def test_a_bad_remap_line_names_the_ini_line(machine, tmp_path):
                        match=r"bad.ini:3:0: REMAP=M400 ngc=x python=y: "
                              "ngc= and python= exclude each other"):
         machine.configure_from_ini(IniFile(str(ini)))
+
+
+def test_task_and_call_level_on_a_machine(machine):
+    """#<_task> is 1 in the machine's interpreter (0 in rs274 and in a
+    preview); G97 is the machine's only spindle mode, G96 is refused."""
+    m = machine
+    turn_on(m)
+    m.mode(TaskMode.MDI)
+    m.mdi("#1 = #<_task>")
+    m.mdi("#2 = [#<_vmajor> + #<_call_level>]")
+    m.mdi("G97 S100")
+    assert (m.params.get(1), m.params.get(2)) == (1.0, 2.9)
+    with pytest.raises(MachineError, match="G96"):
+        m.mdi("G96 S100")
