@@ -128,6 +128,12 @@ class Interpreter:
         self.canon = canon
         #: ``ini(SECTION, KEY)``: the INI value behind ``#<_ini[s]k>``
         self.ini = ini
+        #: ``user_m(number)``: the executable of a user M-code M100-M199
+        #: or None (a machine sets it; without it they are unknown)
+        self.user_m: Optional[Callable[[int], Optional[str]]] = None
+        #: ``hal_value(name)``: the value behind ``#<_hal[name]>`` or None
+        #: (a machine sets it; rs274 has no HAL, as the reference's)
+        self.hal_value: Optional[Callable[[str], Optional[float]]] = None
         #: emit the reference's informational calls (COMMENT, START_CHANGE
         #: ...) as Trace commands: only for canons that ask for them
         self.ref = bool(getattr(canon, "reference_calls", False))
@@ -389,6 +395,8 @@ class Interpreter:
                                  line))
         if 9 in ms:
             self._overrides(block, ms[9])
+        if 10 in ms:
+            self._user_m_code(block, ms[10])
         if gs.get(0) == 40:
             p = self._need(block, "p", "G4")
             if p < 0:
@@ -646,6 +654,8 @@ class Interpreter:
 
     def _check(self, block: Block, gs: dict[int, int],
                ms: dict[int, int]) -> None:
+        if 10 in ms:
+            self._user_m_path(block, ms[10])
         axes = self._axis_words(block)
         g0 = gs.get(0)
         user0 = g0 in AXIS_USERS_GROUP0
@@ -730,6 +740,8 @@ class Interpreter:
             allowed |= set("rqp")
         if 9 in ms:
             allowed.add("p")
+        if 10 in ms:
+            allowed |= set("pq")
         return allowed
 
     # -- tools -----------------------------------------------------------
@@ -1737,6 +1749,25 @@ class Interpreter:
                 self._emit(C.SpindleOn(1 if self.modal.spindle == 30 else -1,
                                        self.speed, line))
 
+    # -- user M-codes M100-M199 ------------------------------------------
+    def _user_m_path(self, block: Block, code: int) -> str:
+        """The executable of a user M-code, checked when the block is
+        read, as the reference does: unknown without one."""
+        number = code // 10
+        path = self.user_m(number) if self.user_m is not None else None
+        if path is None:
+            raise block.error(f"Unknown m code used: M{number} (no "
+                              f"executable file M{number} on the M-code "
+                              "search path)", f"m{number}")
+        return path
+
+    def _user_m_code(self, block: Block, code: int) -> None:
+        """Run the program of M100-M199 with P and Q (the machine waits
+        for it, at rest, before the program goes on)."""
+        path = self._user_m_path(block, code)
+        self._emit(C.UserMCode(code // 10, path, block.words.get("p", -1.0),
+                               block.words.get("q", -1.0), block.line))
+
     # -- predefined named parameters -------------------------------------
     def _ini_value(self, name: str) -> Optional[float]:
         """``#<_ini[section]key>``: section and key upper case, as the
@@ -1756,6 +1787,12 @@ class Interpreter:
         name = name.strip("<>").lower()
         if name.startswith("_ini[") and "]" in name:
             return self._ini_value(name)
+        if name.startswith("_hal[") and name.endswith("]"):
+            # read when the block is evaluated (a machine reads ahead of
+            # motion: M66 E0 L0 before it waits for the moves)
+            if self.hal_value is None:
+                return None
+            return self.hal_value(name[len("_hal["):-1])
         if name.isdigit():              # #5420..#5428
             i = int(name) - 5420
             return self.program_position()[i] / self._k(i)

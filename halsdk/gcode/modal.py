@@ -41,6 +41,7 @@ M_GROUPS: dict[int, tuple[int, ...]] = {
     7: (30, 40, 50, 190, 700, 710, 720, 730),
     8: (70, 80, 90),
     9: (480, 490, 500, 510, 520, 530),
+    10: tuple(range(1000, 2000, 10)),      # user M-codes M100-M199
 }
 _G_OF = {code: group for group, codes in G_GROUPS.items() for code in codes}
 _M_OF = {code: group for group, codes in M_GROUPS.items() for code in codes}
