@@ -165,6 +165,24 @@ def test_unknown_m_code_names_the_line(hal, tmp_path, mcodes):
         run(m, tmp_path, "G21 G0 X1\nM120\nM2\n")
 
 
+def test_the_ini_keys_are_known_to_the_ini_check(tmp_path):
+    from halsdk.machine.inicheck import check_ini
+    ini = tmp_path / "machine.ini"
+    ini.write_text(INI + "HAL_PIN_VARS = 1\nHALSDK_MAX_ITERATIONS = 9\n"
+                   "HALSDK_MAX_IDLE_TIME = 9\nHALSDK_USER_M_TIMEOUTS = 1\n")
+    problems = [str(p) for p in check_ini(IniFile(str(ini)))]
+    assert len(problems) == 1
+    assert "HALSDK_USER_M_TIMEOUTS: unknown key" in problems[0]
+    assert "HALSDK_USER_M_TIMEOUT" in problems[0]      # the suggestion
+
+
+def test_a_bad_timeout_in_the_ini_names_the_line(hal, tmp_path):
+    with pytest.raises(MachineError, match="machine.ini:5: "
+                       "HALSDK_USER_M_TIMEOUT '0' is not a number of "
+                       "seconds above 0"):
+        build(hal, tmp_path, INI.replace("= 3", "= 0"))
+
+
 def test_the_search_path_order(tmp_path):
     for name in ("programs", "mcodes", "more"):
         (tmp_path / name).mkdir()
