@@ -1,6 +1,7 @@
-"""User M-codes (M100-M199) and #<_hal[name]> on a simulated machine:
-the programs are run through halsdk.machine.Machine, the M-code is a
-script on the INI's USER_M_PATH, the HAL items are set while it runs."""
+"""User M-codes (M100-M199), #<_hal[name]> and G5.2 NURBS on a
+simulated machine: the programs are run through halsdk.machine.Machine,
+the M-code is a script on the INI's USER_M_PATH, the HAL items are set
+while it runs."""
 
 from __future__ import annotations
 
@@ -273,3 +274,26 @@ def test_hal_item_unknown_or_feature_off_is_an_error(hal, tmp_path,
     with pytest.raises(MachineError, match=r"#<_hal\[nope\]> is not "
                        "defined"):
         run(m, tmp_path, "#1 = #<_hal[nope]>\nM2\n")
+
+
+def test_a_nurbs_block_moves_the_machine_along_the_curve(hal, tmp_path):
+    from halsdk.gcode.nurbs import knot_vector, point
+    m = build(hal, tmp_path, INI)
+    xs: list[tuple[float, float]] = []
+    hal.add_python_function("xy-trace", lambda period: xs.append(
+        (hal.getp("joint.0.motor-pos-cmd"),
+         hal.getp("joint.1.motor-pos-cmd"))), thread="servo-thread")
+    start(m, tmp_path, "G21 G90 G0 X0 Y0\nF6000\nG5.2 P1 L3\nX0 Y10 P1\n"
+          "X20 Y20 P1\nX20 Y0 P1\nX0 Y0 P2\nG5.3\nM2\n")
+    m.wait_program(timeout=60)          # (servo time: no M-code here)
+    assert m.status().position[:2] == pytest.approx((0, 0), abs=1e-6)
+    ctrl = [(0, 0), (0, 10), (20, 20), (20, 0), (0, 0)]
+    knots = knot_vector(5, 3)
+    curve = [point(ctrl, [1, 1, 1, 1, 2], 3, knots, j / 400)
+             for j in range(401)]
+    # the machine went as far right and up as the curve, not further
+    assert max(x for x, _ in xs) == pytest.approx(
+        max(x for x, _ in curve), abs=0.01)
+    assert max(y for _, y in xs) == pytest.approx(
+        max(y for _, y in curve), abs=0.01)
+    assert [e for e in m.errors() if e[0] == "error"] == []
