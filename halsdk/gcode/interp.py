@@ -1342,12 +1342,15 @@ class Interpreter:
             raise block.error("the order L must be a whole number", "l")
         weight = w.get("p")
         if not self.ref:
-            self._nurbs_machine_checks(block, key, order, weight)
+            self._nurbs_machine_checks(block, key, order, weight,
+                                       points is None)
         if points is None:
             if self.modal.feed_mode != 930 and self.feed <= 0:
                 raise block.error("Cannot make a NURBS with 0 feedrate", key)
-            weight = 1.0 if weight is None else weight
-            points = [(list(self.pos), weight)]
+            # the start point weighs P when the line has no point of its
+            # own, else 1 (as the reference's preview draws it)
+            start = 1.0 if has_x or weight is None else weight
+            points = [(list(self.pos), start)]
             self._nurbs_points = points
             self._nurbs_order = 3
         else:
@@ -1365,11 +1368,11 @@ class Interpreter:
             end = self._target(block)
             point = list(self.pos)
             point[0], point[1] = end[0], end[1]
-            points.append((point, weight))
+            points.append((point, -1.0 if weight is None else weight))
 
     def _nurbs_machine_checks(self, block: Block, key: str,
                               order: Optional[float],
-                              weight: Optional[float]) -> None:
+                              weight: Optional[float], first: bool) -> None:
         """What the reference's rs274 lets through and a machine cannot
         run: a curve outside the XY plane or moving other axes, with
         cutter compensation, in inverse time, without weights."""
@@ -1387,6 +1390,10 @@ class Interpreter:
                               "supported", key)
         if weight is not None and weight <= 0:
             raise block.error("NURBS weights P must be above 0", "p")
+        if first and weight is None and "x" in block.words:
+            # (the reference then weighs the point -1: a curve far off)
+            raise block.error("a NURBS control point needs its weight P "
+                              "(also on the first line)", key)
         if order is not None and order < 2:
             raise block.error("the NURBS order L must be at least 2", "l")
 

@@ -7,9 +7,11 @@ output is compared with the reference's in tests/gcode/programs/nurbs/.
 
 from __future__ import annotations
 
+import ast
 import math
 
 import pytest
+from helpers import repo_path
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -120,9 +122,9 @@ polygons = st.integers(3, 7).flatmap(lambda n: st.tuples(
 @given(polygons)
 def test_feeds_lie_on_the_curve_within_the_tolerance(case):
     ctrl, weights, order = case
-    # the first control point is where the tool is (its weight: the
-    # first block's P, as it is given with the second point here)
-    weights = [weights[1]] + weights[1:]
+    # the first control point is where the tool is; its weight is 1
+    # when the first line gives a point (and its weight) of its own
+    weights = [1.0] + weights[1:]
     out = feeds(run(program(ctrl, weights, order)))
     points = [c.end[:2] for c in out]
     assert points, "no feed"
@@ -183,6 +185,7 @@ def test_inch_program_on_a_metric_machine():
     ("F10\nG5.2 X1 Y1 P1 L1\nX2 Y2 P1\nG5.3\n", "at least 2"),
     ("F10\nG5.2 X1 Y1 P1 L2.5\n", "whole number"),
     ("F10\nG5.2 X1 Y1 P1\nX2 Y2\nG5.3\n", "positive weight P"),
+    ("F10\nG5.2 X1 Y1 L2\nX2 Y2 P1\nG5.3\n", "needs its weight P"),
     ("F10\nG5.2 X1 Y1 P1\nG5.3\n", "at least equal to the order L = 3"),
     ("F10\nG5.3\n", "without G5.2 first"),
     ("G5.2 X1 Y1 P1\n", "0 feedrate"),
@@ -206,3 +209,27 @@ def test_polyline_module_checks_and_the_order_2_case():
     points = polyline([(0, 0), (1, 1), (2, 0)], [1, 1, 1], 2, 0.001)
     assert points == [(0.25, 0.25), (0.5, 0.5), (0.75, 0.75), (1.0, 1.0),
                       (1.25, 0.75), (1.5, 0.5), (1.75, 0.25), (2, 0)]
+
+
+PREVIEW = repo_path("tests", "data", "gcode", "nurbs-preview")
+
+
+@pytest.mark.parametrize("name", ["manual", "first_point_weighted",
+                                  "start_weight", "start_without_weight"])
+def test_the_curve_is_the_reference_preview_s(name):
+    # the reference's preview interpreter cuts the curve into straight
+    # feeds on it: each of them lies within our tolerance of our chords
+    # (so the knots, the weights and the start point's weight agree)
+    ref = []
+    for line in (PREVIEW / f"{name}.reference").read_text().splitlines():
+        if line.startswith("straight_feed"):
+            x, y, _ = ast.literal_eval(line.split(" ", 1)[1])
+            ref.append((x * 25.4, y * 25.4))
+    text = (PREVIEW / f"{name}.ngc").read_text()
+    ours = [c.end[:2] for c in feeds(run(text))]
+    start = next(c.end[:2] for c in run(text)
+                 if isinstance(c, C.StraightTraverse))
+    assert ours[-1] == pytest.approx(ref[-1], abs=1e-9)
+    path = [start] + ours
+    worst = max(distance_to_polyline(p, path) for p in ref)
+    assert worst <= TOL_MM * 1.01
