@@ -43,6 +43,7 @@ from halsdk.channels.constants import (
     EXEC_WAITING_FOR_DELAY,
     EXEC_WAITING_FOR_IO,
     EXEC_WAITING_FOR_MOTION,
+    EXEC_WAITING_FOR_SYSTEM_CMD,
     JOG_CONTINUOUS,
     JOG_INCREMENT,
     JOG_STOP,
@@ -1064,6 +1065,8 @@ class TaskController:
             return EXEC_WAITING_FOR_DELAY
         if name in ("ChangeTool", "SelectTool", "ChangeToolNumber"):
             return EXEC_WAITING_FOR_IO
+        if name == "UserMCode" and self.executor.phase:
+            return EXEC_WAITING_FOR_SYSTEM_CMD      # M100-M199 running
         return EXEC_WAITING_FOR_MOTION
 
     def snapshot(self) -> dict:

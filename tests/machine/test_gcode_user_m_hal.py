@@ -138,6 +138,22 @@ def test_the_machine_waits_for_the_m_code(hal, tmp_path, mcodes):
     assert m.status().position[0] == pytest.approx(9)
 
 
+def test_mdi_m_code_and_the_exec_state_while_it_runs(hal, tmp_path, mcodes):
+    from halsdk.channels.constants import EXEC_DONE, EXEC_WAITING_FOR_SYSTEM_CMD
+    executable(mcodes / "M105", '#!/bin/sh\necho "$1 $2" > args\n'
+               'while [ ! -e go ]; do sleep 0.05; done\n')
+    m = build(hal, tmp_path, INI)
+    m.mode(TaskMode.MDI)
+    m.mdi("M105 P7 Q-0.5", wait=False)
+    settle(m, 10, until=lambda: (mcodes / "args").exists())
+    assert (mcodes / "args").read_text() == "7.000000 -0.500000\n"
+    assert m.exec_state() == EXEC_WAITING_FOR_SYSTEM_CMD
+    (mcodes / "go").write_text("")
+    settle(m, 10, until=lambda: m.exec_state() == EXEC_DONE
+           and m.status().interp_state is InterpState.IDLE)
+    assert [e for e in m.errors() if e[0] == "error"] == []
+
+
 @pytest.mark.parametrize("script, why", [
     ("exit 3", "exited with status 3"),
     ("kill -TERM $$", "was killed by signal 15"),
