@@ -257,6 +257,18 @@ class Message(Command):
     line: int = 0
 
 
+@dataclass(frozen=True)
+class UserMCode(Command):
+    """A user M-code (M100-M199): run the executable ``path`` with the
+    block's P and Q (-1.0 when the block has none, as the reference) and
+    wait for it to finish, with the machine at rest."""
+    code: int
+    path: str
+    p: float = -1.0
+    q: float = -1.0
+    line: int = 0
+
+
 class Canon:
     """Receiver of canonical commands; subclasses override :meth:`emit`."""
 

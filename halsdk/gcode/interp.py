@@ -38,6 +38,7 @@ from ._fast import fast_move
 from .block import Block, code_key
 from .cutter_radius import CutterComp, CutterRadiusError
 from .modal import AXIS_USERS_GROUP0, ModalState, group_codes
+from .nurbs import polyline as nurbs_polyline
 
 _DEBUG_PARAM = re.compile(r"#\s*<([^>]*)>|#\s*(\d+)")
 
@@ -128,6 +129,12 @@ class Interpreter:
         self.canon = canon
         #: ``ini(SECTION, KEY)``: the INI value behind ``#<_ini[s]k>``
         self.ini = ini
+        #: ``user_m(number)``: the executable of a user M-code M100-M199
+        #: or None (a machine sets it; without it they are unknown)
+        self.user_m: Optional[Callable[[int], Optional[str]]] = None
+        #: ``hal_value(name)``: the value behind ``#<_hal[name]>`` or None
+        #: (a machine sets it; rs274 has no HAL, as the reference's)
+        self.hal_value: Optional[Callable[[str], Optional[float]]] = None
         #: emit the reference's informational calls (COMMENT, START_CHANGE
         #: ...) as Trace commands: only for canons that ask for them
         self.ref = bool(getattr(canon, "reference_calls", False))
@@ -168,6 +175,10 @@ class Interpreter:
         self._spline_pq = (0.0, 0.0)            # G5: the last P, Q
         #: REMAP= codes and the [PYTHON] plugin (halsdk.gcode.remap)
         self.remap: Any = None
+        #: G5.2: the control points so far (machine position, weight)
+        #: and the order
+        self._nurbs_points: Optional[list[tuple[list[float], float]]] = None
+        self._nurbs_order = 3
         #: the program being run (for M73: its call level)
         self._program: Any = None
         #: M70 state and the M73 state with its call level
@@ -418,6 +429,8 @@ class Interpreter:
                                  line))
         if 9 in ms:
             self._overrides(block, ms[9])
+        if 10 in ms:
+            self._user_m_code(block, ms[10])
         if gs.get(0) == 40:
             p = self._need(block, "p", "G4")
             if p < 0:
@@ -698,6 +711,8 @@ class Interpreter:
 
     def _check(self, block: Block, gs: dict[int, int],
                ms: dict[int, int]) -> None:
+        if 10 in ms:
+            self._user_m_path(block, ms[10])
         axes = self._axis_words(block)
         g0 = gs.get(0)
         user0 = g0 in AXIS_USERS_GROUP0
@@ -760,6 +775,8 @@ class Interpreter:
             allowed |= set("ijpq")
         elif moving and motion == 51:
             allowed |= set("ij")
+        elif moving and motion == 52:
+            allowed |= set("pl")
         elif moving and (motion in CANNED or motion in UNSUPPORTED_MOTION):
             allowed |= set("rlpq")
             if motion == 870:
@@ -782,6 +799,8 @@ class Interpreter:
             allowed |= set("rqp")
         if 9 in ms:
             allowed.add("p")
+        if 10 in ms:
+            allowed |= set("pq")
         return allowed
 
     # -- tools -----------------------------------------------------------
@@ -1248,6 +1267,9 @@ class Interpreter:
             return
         line = block.line
         key = code_key("g", motion / 10)
+        if motion in (52, 53):
+            self._nurbs(block, motion)
+            return
         g53 = gs.get(0) == 530
         if self.comp.active and (motion not in (0, 10, 20, 30) or g53):
             raise block.error(f"G{'53' if g53 else f'{motion / 10:g}'} "
@@ -1347,6 +1369,120 @@ class Interpreter:
             point = list(end)
             point[0], point[1] = x, y
             self._emit(C.StraightFeed(_pose(point), feed, block.line))
+        self.pos = list(end)
+
+    # -- G5.2/G5.3 NURBS blocks ---------------------------------------------
+    def _nurbs(self, block: Block, motion: int) -> None:
+        """G5.2 adds control points (the first block also the position
+        where the tool is), G5.3 ends the block and moves along the
+        curve: rs274 prints the reference's NURBS_FEED; a machine gets
+        straight feeds within 1 um (0.00004 in) of it (:mod:`.nurbs`).
+        The checks and their order are the reference's; a machine also
+        refuses what has no meaning for it."""
+        key = code_key("g", motion / 10)
+        w = block.words
+        has_x, has_y = "x" in w, "y" in w
+        points = self._nurbs_points if self._previous_motion == 52 else None
+        if motion == 53:
+            if points is None:
+                raise block.error("Cannot use G5.3 without G5.2 first", key)
+            self._nurbs_points = None
+            self.modal.motion = 800
+            if len(points) < self._nurbs_order:
+                raise block.error("You must specify a number of control "
+                                  "points at least equal to the order L = "
+                                  f"{self._nurbs_order}", key)
+            self._nurbs_feed(block, points)
+            if has_x != has_y:      # (after the curve, as the reference)
+                raise block.error("You must specify both X and Y "
+                                  "coordinates for Control Points", key)
+            return
+        if has_x != has_y:
+            raise block.error("You must specify both X and Y coordinates "
+                              "for Control Points", key)
+        order = w.get("l")
+        if order is not None and order < 0:
+            raise block.error("Negative l word used", "l")
+        if order is not None and order != int(order):
+            raise block.error("the order L must be a whole number", "l")
+        weight = w.get("p")
+        if not self.ref:
+            self._nurbs_machine_checks(block, key, order, weight,
+                                       points is None)
+        if points is None:
+            if self.modal.feed_mode != 930 and self.feed <= 0:
+                raise block.error("Cannot make a NURBS with 0 feedrate", key)
+            # the start point weighs P when the line has no point of its
+            # own, else 1 (as the reference's preview draws it)
+            start = 1.0 if has_x or weight is None else weight
+            points = [(list(self.pos), start)]
+            self._nurbs_points = points
+            self._nurbs_order = 3
+        else:
+            if not has_x:
+                raise block.error("Can specify P without X and Y only for "
+                                  "the first control point", key)
+            if weight is None or weight <= 0:
+                raise block.error("Must specify positive weight P for "
+                                  "every Control Point", key)
+        if order is not None:
+            self._nurbs_order = int(order)
+        if has_x:
+            # (relative to where the tool is, not to the last point, in
+            # G91: the reference's position moves only at G5.3)
+            end = self._target(block)
+            point = list(self.pos)
+            point[0], point[1] = end[0], end[1]
+            points.append((point, -1.0 if weight is None else weight))
+
+    def _nurbs_machine_checks(self, block: Block, key: str,
+                              order: Optional[float],
+                              weight: Optional[float], first: bool) -> None:
+        """What the reference's rs274 lets through and a machine cannot
+        run: a curve outside the XY plane or moving other axes, with
+        cutter compensation, in inverse time, without weights."""
+        if self.modal.plane != 170:
+            raise block.error("a NURBS (G5.2) must be in the XY plane (G17)",
+                              key)
+        if any(a in block.words for a in "zabcuvw"):
+            raise block.error("a NURBS (G5.2) may not move Z, A, B, C, U, V "
+                              "or W", key)
+        if self.comp.active:
+            raise block.error("G5.2 while cutter compensation is on is not "
+                              "supported", key)
+        if self.modal.feed_mode == 930:
+            raise block.error("G5.2 in inverse time feed (G93) is not "
+                              "supported", key)
+        if weight is not None and weight <= 0:
+            raise block.error("NURBS weights P must be above 0", "p")
+        if first and weight is None and "x" in block.words:
+            # (the reference then weighs the point -1: a curve far off)
+            raise block.error("a NURBS control point needs its weight P "
+                              "(also on the first line)", key)
+        if order is not None and order < 2:
+            raise block.error("the NURBS order L must be at least 2", "l")
+
+    def _nurbs_feed(self, block: Block,
+                    points: list[tuple[list[float], float]]) -> None:
+        end = points[-1][0]
+        if self.ref:
+            self._trace(f"NURBS_FEED({len(points)}, ...)")
+            self.pos = list(end)
+            return
+        tol = 0.001 if self.machine_metric else 0.00004
+        try:
+            chords = nurbs_polyline([(p[0], p[1]) for p, _ in points],
+                                    [wt for _, wt in points],
+                                    self._nurbs_order, tol)
+        except ValueError as e:
+            raise block.error(f"NURBS: {e}", "g5.3") from None
+        length = sum(math.dist(a, b) for a, b in zip(
+            [(self.pos[0], self.pos[1])] + chords, chords))
+        feed = self._feed_for(block, length)
+        for x, y in chords:
+            target = list(end)
+            target[0], target[1] = x, y
+            self._emit(C.StraightFeed(_pose(target), feed, block.line))
         self.pos = list(end)
 
     def _spline_segments(self, controls: list[tuple[float, float]]) -> int:
@@ -1802,6 +1938,25 @@ class Interpreter:
                 self._emit(C.SpindleOn(1 if self.modal.spindle == 30 else -1,
                                        self.speed, line))
 
+    # -- user M-codes M100-M199 ------------------------------------------
+    def _user_m_path(self, block: Block, code: int) -> str:
+        """The executable of a user M-code, checked when the block is
+        read, as the reference does: unknown without one."""
+        number = code // 10
+        path = self.user_m(number) if self.user_m is not None else None
+        if path is None:
+            raise block.error(f"Unknown m code used: M{number} (no "
+                              f"executable file M{number} on the M-code "
+                              "search path)", f"m{number}")
+        return path
+
+    def _user_m_code(self, block: Block, code: int) -> None:
+        """Run the program of M100-M199 with P and Q (the machine waits
+        for it, at rest, before the program goes on)."""
+        path = self._user_m_path(block, code)
+        self._emit(C.UserMCode(code // 10, path, block.words.get("p", -1.0),
+                               block.words.get("q", -1.0), block.line))
+
     # -- predefined named parameters -------------------------------------
     def _ini_value(self, name: str) -> Optional[float]:
         """``#<_ini[section]key>``: section and key upper case, as the
@@ -1827,6 +1982,12 @@ class Interpreter:
                 return found
         if name == "_remap_level":
             return float(self.remap.level if self.remap is not None else 0)
+        if name.startswith("_hal[") and name.endswith("]"):
+            # read when the block is evaluated (a machine reads ahead of
+            # motion: M66 E0 L0 before it waits for the moves)
+            if self.hal_value is None:
+                return None
+            return self.hal_value(name[len("_hal["):-1])
         if name.isdigit():              # #5420..#5428
             i = int(name) - 5420
             return self.program_position()[i] / self._k(i)

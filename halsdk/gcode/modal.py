@@ -20,7 +20,7 @@ def _key(value: float) -> int:
 # group number -> codes (tenths). Group 0 is non-modal.
 G_GROUPS: dict[int, tuple[int, ...]] = {
     0: (40, 100, 280, 281, 300, 301, 530, 920, 921, 922, 923),
-    1: (0, 10, 20, 30, 50, 51, 330, 382, 383, 384, 385, 730, 760,
+    1: (0, 10, 20, 30, 50, 51, 52, 53, 330, 382, 383, 384, 385, 730, 760,
         800, 810, 820, 830, 840, 850, 860, 870, 880, 890),
     2: (170, 180, 190),
     3: (900, 910),
@@ -42,6 +42,7 @@ M_GROUPS: dict[int, tuple[int, ...]] = {
     7: (30, 40, 50, 190, 700, 710, 720, 730),
     8: (70, 80, 90),
     9: (480, 490, 500, 510, 520, 530),
+    10: tuple(range(1000, 2000, 10)),      # user M-codes M100-M199
 }
 _G_OF = {code: group for group, codes in G_GROUPS.items() for code in codes}
 _M_OF = {code: group for group, codes in M_GROUPS.items() for code in codes}

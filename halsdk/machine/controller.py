@@ -43,6 +43,7 @@ from halsdk.channels.constants import (
     EXEC_WAITING_FOR_DELAY,
     EXEC_WAITING_FOR_IO,
     EXEC_WAITING_FOR_MOTION,
+    EXEC_WAITING_FOR_SYSTEM_CMD,
     JOG_CONTINUOUS,
     JOG_INCREMENT,
     JOG_STOP,
@@ -83,6 +84,7 @@ from halsdk.machine.task import (
     TaskState,
 )
 from halsdk.machine.tooltable import ToolTable
+from halsdk.machine.usermcode import find_user_m, search_path
 
 __all__ = ["TaskController", "Ticket", "RCS_DONE", "RCS_EXEC", "RCS_ERROR",
            "OPERATOR_ERROR", "OPERATOR_TEXT", "OPERATOR_DISPLAY",
@@ -131,6 +133,16 @@ def subroutine_path(ini: Any) -> list[str]:
     paths = ini.get("RS274NGC", "SUBROUTINE_PATH")
     return [os.path.join(folder, p.strip())
             for p in str(paths or "").split(":") if p.strip()]
+def _ini_flag(ini: Any, key: str, default: bool) -> bool:
+    """[RS274NGC]key as a 0/1 flag; ``default`` when absent."""
+    text = ini.get("RS274NGC", key)
+    if text is None or not str(text).strip():
+        return default
+    try:
+        return float(str(text).split()[0]) != 0
+    except ValueError:
+        raise MachineError(f"{ini.where('RS274NGC', key)}: {key} "
+                           f"'{text}' is not 0 or 1") from None
 
 
 def _ini_limit(ini: Any, key: str, default: float, whole: bool) -> float:
@@ -187,6 +199,12 @@ class TaskController:
         self.ini_filename = ""
         self.units = units
         self._messages: deque[tuple[int, str]] = deque(maxlen=1000)
+        #: the folders searched for user M-codes M100-M199, first to last
+        #: ([DISPLAY]PROGRAM_PREFIX and [RS274NGC]USER_M_PATH)
+        self.user_m_path: list[str] = []
+        #: whether programs read HAL items as #<_hal[name]>
+        #: ([RS274NGC]HAL_PIN_VARS, on by default as in LinuxCNC 2.9)
+        self.hal_pin_vars = True
         self.executor = Executor(motion, io, hal, thread=thread,
                                  message=self._canon_message,
                                  pause=self._m0)
@@ -249,6 +267,12 @@ class TaskController:
                                           self.subroutine_path)
         except GCodeError as exc:
             raise MachineError(str(exc)) from None
+        self.user_m_path = search_path(folder,
+                                       ini.get("DISPLAY", "PROGRAM_PREFIX"),
+                                       ini.get("RS274NGC", "USER_M_PATH"))
+        self.user_m_timeout = _ini_limit(
+            ini, "HALSDK_USER_M_TIMEOUT", self.user_m_timeout, False)
+        self.hal_pin_vars = _ini_flag(ini, "HAL_PIN_VARS", True)
         name = ini.get("RS274NGC", "PARAMETER_FILE")
         if name:
             self.parameter_file = os.path.join(folder, name)
@@ -271,8 +295,38 @@ class TaskController:
         interp.pos = list(self.executor.pos)
         interp.task = True              # #<_task>: the machine's interpreter
         interp.remap = getattr(self, "_remap", None)
+        interp.user_m = self._user_m
+        interp.hal_value = self._hal_value
         self.executor.interp = interp
         return interp
+
+    @property
+    def user_m_timeout(self) -> float:
+        """Seconds a user M-code may run before it is killed and the
+        program aborted ([RS274NGC]HALSDK_USER_M_TIMEOUT)."""
+        return self.executor.user_m_timeout
+
+    @user_m_timeout.setter
+    def user_m_timeout(self, seconds: float) -> None:
+        if not (math.isfinite(seconds) and seconds > 0):
+            raise ValueError(f"user_m_timeout must be above 0, not "
+                             f"{seconds!r}")
+        self.executor.user_m_timeout = float(seconds)
+
+    def _user_m(self, number: int) -> Optional[str]:
+        """The executable of M<number> on the M-code search path."""
+        return find_user_m(number, self.user_m_path)
+
+    def _hal_value(self, name: str) -> Optional[float]:
+        """``#<_hal[name]>``: the value of the pin, param or signal of
+        that name now, None when there is none (or the feature is off)."""
+        if not self.hal_pin_vars:
+            return None
+        for kind in ("pin", "param", "signal"):
+            item = self.hal.find(kind, name)
+            if item is not None:
+                return float(item.value)
+        return None
 
     # -- the error channel ---------------------------------------------------
 
@@ -1024,6 +1078,8 @@ class TaskController:
             return EXEC_WAITING_FOR_DELAY
         if name in ("ChangeTool", "SelectTool", "ChangeToolNumber"):
             return EXEC_WAITING_FOR_IO
+        if name == "UserMCode" and self.executor.phase:
+            return EXEC_WAITING_FOR_SYSTEM_CMD      # M100-M199 running
         return EXEC_WAITING_FOR_MOTION
 
     def snapshot(self) -> dict:

@@ -23,6 +23,7 @@ from typing import Any, Callable, Optional
 from halsdk.gcode import canon as C
 from halsdk.machine.iocontrol import ToolState
 from halsdk.machine.task import MachineError
+from halsdk.machine.usermcode import DEFAULT_TIMEOUT, UserMError, UserMRun
 from halsdk.motion.status import TermCond
 
 __all__ = ["Executor", "ExecutorError"]
@@ -38,7 +39,7 @@ TERM = {"exact_path": TermCond.EXACT, "exact_stop": TermCond.STOP,
 AT_REST = frozenset({"Probe", "Dwell", "Coolant", "ChangeTool",
                      "SpindleOn", "SpindleOff", "SpindleSpeed",
                      "ChangeToolNumber", "WaitInput", "ProgramPause",
-                     "OptionalPause", "ProgramEnd"})
+                     "OptionalPause", "ProgramEnd", "UserMCode"})
 #: plane -> (first, second, normal axis index)
 PLANE_AXES = {17: (0, 1, 2), 18: (2, 0, 1), 19: (1, 2, 0)}
 
@@ -78,6 +79,9 @@ class Executor(C.Canon):
         self._phase = 0
         self._until = 0
         self._last_bit = False
+        #: seconds a user M-code (M100-M199) may run
+        self.user_m_timeout = DEFAULT_TIMEOUT
+        self._user_m: Optional[UserMRun] = None
 
     # -- helpers -----------------------------------------------------------
 
@@ -118,6 +122,9 @@ class Executor(C.Canon):
         """Forget the pending commands (abort)."""
         self.pending.clear()
         self._phase = 0
+        if self._user_m is not None:
+            self._user_m.kill()
+            self._user_m = None
 
     def _feed(self, feed: float, line: int) -> float:
         if not feed > 0:
@@ -329,6 +336,22 @@ class Executor(C.Canon):
         self.io.mist(False)
         self.io.flood(False)
         self.ended = True
+
+    def _do_UserMCode(self, c: C.UserMCode) -> bool:
+        # phase 0: start it (motion at rest); then poll until it exits
+        try:
+            if self._phase == 0:
+                self._user_m = UserMRun(c.code, c.path, c.p, c.q,
+                                        self.user_m_timeout)
+                self._phase = 1
+            assert self._user_m is not None
+            if not self._user_m.poll():
+                return False
+        except UserMError as e:
+            self._user_m = None
+            raise ExecutorError(str(e)) from None
+        self._user_m = None
+        return True
 
     def _do_Message(self, c: C.Message) -> None:
         self.message("display", c.text)

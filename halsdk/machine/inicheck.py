@@ -124,7 +124,9 @@ def _halsdk_keys() -> dict[str, frozenset[str]]:
         "AXIS_L": frozenset(AXIS_KEYS),
         "TASK": _keys("CYCLE_TIME"),
         "EMCIO": _keys("TOOL_TABLE RANDOM_TOOLCHANGER"),
-        "RS274NGC": _keys("SUBROUTINE_PATH PARAMETER_FILE"),
+        "RS274NGC": _keys("SUBROUTINE_PATH PARAMETER_FILE USER_M_PATH "
+                          "HAL_PIN_VARS HALSDK_MAX_ITERATIONS "
+                          "HALSDK_MAX_IDLE_TIME HALSDK_USER_M_TIMEOUT"),
     }
 
 

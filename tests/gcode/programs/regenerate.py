@@ -11,9 +11,11 @@ interpreter, ``reference rs274 -g prog.ngc``, in a fresh folder under
 they exist (``NAME.args`` holds more options, ``-b`` or ``-n 0``), and of
 the library
 files of the group (``.ngc`` files whose first line starts with
-``o<``: subroutine files and REMAP procedures, not programs) and of its
-``.py`` files (the ``[PYTHON]`` plugin of REMAP programs). It writes next
-to the program:
+``o<``: subroutine files and REMAP procedures, not programs), of its
+``.py`` files (the ``[PYTHON]`` plugin of REMAP programs) and of its user
+M-code programs (files named ``M100`` to ``M199``, copied with their
+execute bit, for an INI file's USER_M_PATH). It writes next to the
+program:
 
 * ``NAME.out``: the standard output (the golden data compared byte for
   byte by tests/gcode/test_rs274_golden.py);
@@ -81,6 +83,10 @@ def run_one(prog: Path, reference: str) -> int:
             shutil.copy(module, work / module.name)
         for f in work.iterdir():
             os.chmod(f, 0o644)
+        for mcode in prog.parent.glob("M1[0-9][0-9]"):
+            shutil.copy(mcode, work / mcode.name)
+            os.chmod(work / mcode.name,
+                     0o755 if os.access(mcode, os.X_OK) else 0o644)
         extra = prog.with_suffix(".args")
         if extra.exists():
             args += extra.read_text().split()
