@@ -164,8 +164,9 @@ class CutterComp:
             t = (rx * new.t0[1] - ry * new.t0[0]) / cross
             s = (rx * prev.t1[1] - ry * prev.t1[0]) / cross
             if -t > prev.length + 1e-9 or s > new.length + 1e-9:
-                raise CutterRadiusError("segment too short for the tool radius "
-                                        "(cutter compensation would gouge)")
+                raise CutterRadiusError("Straight feed in concave corner "
+                                        "cannot be reached by the tool "
+                                        "without gouging")
             return (a_end[0] + t * prev.t1[0], a_end[1] + t * prev.t1[1])
         if prev.is_arc and new.is_arc:
             assert prev.centre is not None and new.centre is not None

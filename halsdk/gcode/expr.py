@@ -95,7 +95,7 @@ FUNCTIONS: dict[str, tuple[Callable[[float], float],
     "cos": (_degrees(math.cos), None, ""),
     "sin": (_degrees(math.sin), None, ""),
     "tan": (_degrees(math.tan), None, ""),
-    "exp": (math.exp, lambda x: x < 709, "EXP argument too large"),
+    "exp": (math.exp, lambda x: x < 709, "Calculation resulted in 'infinity'"),
     "fix": (lambda x: float(math.floor(x)), None, ""),
     "fup": (lambda x: float(math.ceil(x)), None, ""),
     "round": (_round, None, ""),
@@ -185,13 +185,19 @@ class Binary(Expr):
                               self.column)
         try:
             result = BINARY[self.op][1](a, b)
-        except (OverflowError, ValueError, ZeroDivisionError) as exc:
+        except OverflowError:
+            raise where.error("Calculation resulted in 'infinity'",
+                              self.column) from None
+        except (ValueError, ZeroDivisionError) as exc:
             raise where.error(f"cannot compute {a:g} {self.op.upper()} "
                               f"{b:g}: {exc}", self.column) from None
         if isinstance(result, complex) or not math.isfinite(result):
             if self.op == "**" and a < 0:
                 raise where.error("Attempt to raise negative to non integer "
                                   "power", self.column)
-            raise where.error(f"{a:g} {self.op.upper()} {b:g} is not a real "
-                              "number", self.column)
+            raise where.error("Calculation resulted in 'not a number'"
+                              if isinstance(result, complex)
+                              or math.isnan(result) else
+                              "Calculation resulted in 'infinity'",
+                              self.column)
         return float(result)

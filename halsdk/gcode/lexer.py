@@ -339,7 +339,7 @@ def _unsigned_number(reader: _Reader) -> float:
     try:
         return float(digits)
     except ValueError:
-        raise reader.error("bad number", start) from None
+        raise reader.error("Bad format unsigned integer", start) from None
 
 
 def _number(reader: _Reader) -> Number:
@@ -410,8 +410,10 @@ def _bracketed(reader: _Reader) -> Expr:
     if reader.peek() != "]":
         if reader.at_end():
             raise reader.error("Unclosed expression", open_column)
-        raise reader.error(f"expected an operator or ']', found "
-                           f"'{reader.peek()}'")
+        if reader.peek().isalpha():
+            raise reader.error("Unknown operation name starting with "
+                               f"{reader.peek()}")
+        raise reader.error("Unknown operation")
     reader.take()
     return value
 
