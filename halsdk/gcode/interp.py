@@ -668,10 +668,10 @@ class Interpreter:
             raise block.error("P word missing with G76", "g76")
         if not any(a in w for a in AXES):
             raise block.error("All axes missing with motion code", "g76")
-        if "z" not in w:
-            raise block.error("Z word missing with G76", "g76")
         if any(letter not in w for letter in "ijk"):
             raise block.error("I J or K words missing with G76", "g76")
+        if "z" not in w:
+            raise block.error("Z word missing with G76", "g76")
 
     def _arc_message(self, zero: bool, names: str, start: list[float],
                      end: list[float], centre: tuple[float, float],
@@ -707,8 +707,8 @@ class Interpreter:
         if gs.get(1) in (20, 30) and "p" in block.words and \
                 0 not in gs and not ms:
             self._arc_turns(block)      # checked before the line runs
-        if gs.get(1) == 330 and "k" not in block.words:
-            raise block.error("K word missing with g33/g33.1", "g33")
+        if g0 == 920 and not axes:
+            raise block.error("All axes missing with g52 or g92", "g92")
         if gs.get(1) == 760:        # G76 is checked before the line runs
             self._g76_words(block)
         if 1 in gs and not axes and (gs[1] in CANNED or gs[1] in (
@@ -723,13 +723,15 @@ class Interpreter:
         motion = gs.get(1, self.modal.motion)
         if 1 not in gs and motion in (50, 51):
             motion = 800        # a spline is not repeated by axis words
-        if axes and not user0 and gs.get(8) != 431 and motion == 800:
+        g43_2_h = gs.get(8) == 432 and "h" in block.words   # (below)
+        if axes and not user0 and gs.get(8) != 431 and not g43_2_h \
+                and motion == 800:
             raise block.error(
                 "Cannot use axis values with g80" if gs.get(1) == 800 else
                 "Cannot use axis values without a g code that uses them",
                 axes[0])
         users: Optional[set[str]] = None
-        for letter in block.words:
+        for letter in sorted(block.words):      # the reference's order
             if letter in ALWAYS_ALLOWED:
                 continue
             if letter == "q" and self.ref and block.words["q"] == -1.0:
@@ -738,6 +740,11 @@ class Interpreter:
                 users = self._word_users(block, gs, ms, motion)
             if letter not in users:
                 raise block.error(unused_word(letter), letter)
+        if g43_2_h and axes:
+            raise block.error("G43.2: Can not have both H and axis words",
+                              "g43.2")
+        if gs.get(1) == 330 and "k" not in block.words:
+            raise block.error("K word missing with g33/g33.1", "g33")
 
     def _word_users(self, block: Block, gs: dict[int, int],
                     ms: dict[int, int], motion: int) -> set[str]:
@@ -760,7 +767,11 @@ class Interpreter:
         elif moving and motion == 51:
             allowed |= set("ij")
         elif moving and (motion in CANNED or motion in UNSUPPORTED_MOTION):
-            allowed |= set("rlpq")
+            allowed |= set("rl")
+            if motion in (820, 840, 860, 880, 890):
+                allowed.add("p")        # a dwell
+            if motion in (730, 830):
+                allowed.add("q")        # a peck
             if motion == 870:
                 allowed |= set("ijk")
         if g0 == 40:
@@ -920,6 +931,9 @@ class Interpreter:
                 frontangle=0.0, backangle=0.0, orientation=0))
 
     def _tool_length(self, block: Block, code: int) -> None:
+        if self.comp.active:
+            raise block.error("Cannot change tool offset with cutter radius "
+                              "compensation on", code_key("g", code / 10))
         if code == 490:
             offset = [0.0] * 9
         elif code == 431:

@@ -71,6 +71,13 @@ def _by_group(block: Block, letter: str, values: Iterable[float],
                               if letter == "m" else "Unknown g code used",
                               name)
         group = groups[code]
+        if letter == "g" and group == 1 and 1 in found and \
+                800 in (code, found[1]):
+            # G80 beside another motion code: the other one, as the
+            # reference does
+            if code == 800:
+                continue
+            del found[1]
         if group in found:
             raise block.error(f"Two {letter} codes used from same modal "
                               "group", name)
