@@ -414,7 +414,7 @@ def fast_move(object interp, object block):
         f = words.get("f")
         if f is not None:
             if f < 0:
-                raise block.error("negative feed rate", "f")
+                raise block.error("Negative f word used", "f")
             interp.feed = interp._len(f)
             interp._emit(_SetFeedRate(interp.feed, line))
     if explicit is not None:
@@ -429,7 +429,7 @@ def fast_move(object interp, object block):
             else:
                 feed = interp.feed
                 if feed <= 0:
-                    raise block.error("feed move with zero feed rate", "")
+                    raise block.error("Cannot do g1 with zero feed rate", "")
             _emit(interp, _straight_feed(tuple(end), feed, line))
             interp.pos = end
     elif motion == 0:
@@ -468,28 +468,26 @@ cdef bint _arc(object interp, object block, dict words, object modal,
     k = _factor(interp, modal)
     tol = 0.005 if interp.machine_metric else 0.0005
     if w1 not in words and w2 not in words:
-        raise block.error(f"{w1.upper()} and {w2.upper()} words both "
-                          "missing for a centre-format arc",
-                          code_key("g", motion / 10))
+        return False
     o1 = <double>words.get(w1, 0.0) * k
     o2 = <double>words.get(w2, 0.0) * k
     c1 = s1 + o1
     c2 = s2 + o2
     r1 = _hypot(s1 - c1, s2 - c2)
     r2 = _hypot(e1 - c1, e2 - c2)
-    if r1 < 1e-9:
-        raise block.error("zero radius arc", code_key("g", motion / 10))
-    if abs(r1 - r2) > tol and abs(r1 - r2) > 0.001 * r1:
-        raise block.error(
-            f"radius to end of arc differs from radius to start "
-            f"by {abs(r1 - r2) / k:.4g}", code_key("g", motion / 10))
+    # an error (P, feed, radii): Interpreter._arc raises it, in the
+    # reference's order and words
+    if r1 < tol or r2 < tol or (abs(r1 - r2) > tol
+                                and abs(r1 - r2) > 0.001 * r1):
+        return False
     turns = 1
     if "p" in words:
         p = words["p"]
         if p < 1 or abs(p - _round(p)) > 1e-6:
-            raise block.error("arc P (turns) must be a positive integer",
-                              "p")
+            return False
         turns = int(_round(p))
+    if modal.feed_mode != 930 and interp.feed <= 0:
+        return False
     turn = turns if motion == 30 else -turns
     # Interpreter._arc_length
     r = _hypot(s1 - c1, s2 - c2)
@@ -512,8 +510,6 @@ cdef bint _arc(object interp, object block, dict words, object modal,
         feed = interp._feed_for(block, length)
     else:
         feed = interp.feed
-        if feed <= 0:
-            raise block.error("feed move with zero feed rate", "")
     _emit(interp, _arc_feed(tuple(end), (c1, c2), modal.plane // 10, turn,
                             feed, line))
     interp.pos = end

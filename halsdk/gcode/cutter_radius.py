@@ -111,12 +111,13 @@ class CutterComp:
 
     def start(self, side: int, radius: float, plane: int = 17) -> None:
         if plane not in PLANE_AXES:
-            raise CutterRadiusError("cutter compensation works in the XY "
-                                    "and XZ planes (G17, G18) only")
+            raise CutterRadiusError("Cutter radius compensation allowed "
+                                    "only in XY, XZ planes")
         self.plane = plane
         self._a1, self._a2 = PLANE_AXES[plane]
         if self.active:
-            raise CutterRadiusError("cutter compensation is already on (G40 first)")
+            raise CutterRadiusError("Cannot turn cutter radius comp on when "
+                                    "on")
         if radius < 0:
             raise CutterRadiusError("negative tool radius for cutter compensation")
         self.side, self.radius = side, radius
@@ -163,8 +164,9 @@ class CutterComp:
             t = (rx * new.t0[1] - ry * new.t0[0]) / cross
             s = (rx * prev.t1[1] - ry * prev.t1[0]) / cross
             if -t > prev.length + 1e-9 or s > new.length + 1e-9:
-                raise CutterRadiusError("segment too short for the tool radius "
-                                        "(cutter compensation would gouge)")
+                raise CutterRadiusError("Straight feed in concave corner "
+                                        "cannot be reached by the tool "
+                                        "without gouging")
             return (a_end[0] + t * prev.t1[0], a_end[1] + t * prev.t1[1])
         if prev.is_arc and new.is_arc:
             assert prev.centre is not None and new.centre is not None
@@ -233,6 +235,11 @@ class CutterComp:
         a1, a2 = self._a1, self._a2
         dx, dy = end[a1] - start[a1], end[a2] - start[a2]
         length = math.hypot(dx, dy)
+        if self._pending is None and self._last_dir is None and \
+                length <= self.radius:
+            raise CutterRadiusError("Length of cutter compensation entry "
+                                    "move is not greater than the tool "
+                                    "radius")
         if length < 1e-9:
             # no motion in the plane: release the held segment, move at
             # its offset end
@@ -262,8 +269,8 @@ class CutterComp:
                        self._tangent(e, centre, turn), 0.0, feed, line,
                        centre, turn, radius, list(start))
         if self._offset_radius(seg) <= 1e-9:
-            raise CutterRadiusError("tool radius too big for the arc under "
-                                    "cutter compensation")
+            raise CutterRadiusError("Tool radius not less than arc radius "
+                                    "with comp")
         if self._pending is None and self._last_dir is None:
             self._entry_arc(seg)
         self._add(seg)

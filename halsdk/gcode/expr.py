@@ -55,7 +55,7 @@ class ParamRef(Expr):
         value = self.index.evaluate(params, where)
         number = round(value)
         if abs(number - value) > 1e-4:
-            raise where.error(f"parameter number {value:g} is not an integer",
+            raise where.error("Non integer value for integer",
                               self.column)
         return int(number)
 
@@ -89,18 +89,18 @@ FUNCTIONS: dict[str, tuple[Callable[[float], float],
                            Callable[[float], bool] | None, str]] = {
     "abs": (abs, None, ""),
     "acos": (lambda x: math.degrees(math.acos(x)), lambda x: -1 <= x <= 1,
-             "ACOS argument outside -1..1"),
+             "Argument to acos out of range"),
     "asin": (lambda x: math.degrees(math.asin(x)), lambda x: -1 <= x <= 1,
-             "ASIN argument outside -1..1"),
+             "Argument to asin out of range"),
     "cos": (_degrees(math.cos), None, ""),
     "sin": (_degrees(math.sin), None, ""),
     "tan": (_degrees(math.tan), None, ""),
-    "exp": (math.exp, lambda x: x < 709, "EXP argument too large"),
+    "exp": (math.exp, lambda x: x < 709, "Calculation resulted in 'infinity'"),
     "fix": (lambda x: float(math.floor(x)), None, ""),
     "fup": (lambda x: float(math.ceil(x)), None, ""),
     "round": (_round, None, ""),
-    "ln": (math.log, lambda x: x > 0, "LN of a number that is not positive"),
-    "sqrt": (math.sqrt, lambda x: x >= 0, "SQRT of a negative number"),
+    "ln": (math.log, lambda x: x > 0, "Zero or negative argument to ln"),
+    "sqrt": (math.sqrt, lambda x: x >= 0, "Negative argument to sqrt"),
 }
 
 
@@ -114,7 +114,7 @@ class Function(Expr):
         fn, valid, text = FUNCTIONS[self.name]
         value = self.operand.evaluate(params, where)
         if valid is not None and not valid(value):
-            raise where.error(f"{text} ({value:g})", self.column)
+            raise where.error(text, self.column)
         return float(fn(value))
 
 
@@ -178,14 +178,26 @@ class Binary(Expr):
     def evaluate(self, params: Parameters, where: Where) -> float:
         a = self.left.evaluate(params, where)
         b = self.right.evaluate(params, where)
-        if self.op in ("/", "mod") and b == 0:
-            raise where.error("division by zero", self.column)
+        if self.op == "/" and b == 0:
+            raise where.error("Attempt to divide by zero", self.column)
+        if self.op == "mod" and b == 0:
+            raise where.error("Calculation resulted in 'not a number'",
+                              self.column)
         try:
             result = BINARY[self.op][1](a, b)
-        except (OverflowError, ValueError, ZeroDivisionError) as exc:
+        except OverflowError:
+            raise where.error("Calculation resulted in 'infinity'",
+                              self.column) from None
+        except (ValueError, ZeroDivisionError) as exc:
             raise where.error(f"cannot compute {a:g} {self.op.upper()} "
                               f"{b:g}: {exc}", self.column) from None
         if isinstance(result, complex) or not math.isfinite(result):
-            raise where.error(f"{a:g} {self.op.upper()} {b:g} is not a real "
-                              "number", self.column)
+            if self.op == "**" and a < 0:
+                raise where.error("Attempt to raise negative to non integer "
+                                  "power", self.column)
+            raise where.error("Calculation resulted in 'not a number'"
+                              if isinstance(result, complex)
+                              or math.isnan(result) else
+                              "Calculation resulted in 'infinity'",
+                              self.column)
         return float(result)

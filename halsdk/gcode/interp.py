@@ -37,6 +37,7 @@ from . import canon as C
 from ._fast import fast_move
 from .block import Block, code_key
 from .cutter_radius import CutterComp, CutterRadiusError
+from .messages import PLANE_NAME, arc_radius_differs, unused_word, zero_radius_arc
 from .modal import AXIS_USERS_GROUP0, ModalState, group_codes
 from .nurbs import polyline as nurbs_polyline
 
@@ -361,9 +362,11 @@ class Interpreter:
         """Whether the state lets the short path take ``block``: it knows
         neither G7 diameters, nor a rotated coordinate system, nor the
         M73 restore, nor the feed's bookkeeping (an F word: rare on the
-        lines of a CAM program), nor the reference's extra calls of
+        lines of a CAM program), nor an arc's turns (a P word, checked
+        before the line runs), nor the reference's extra calls of
         ``rs274``."""
-        if self.diameter_mode or self._autosaved or "f" in block.words:
+        if self.diameter_mode or self._autosaved or "f" in block.words \
+                or "p" in block.words:
             return False
         if self.ref and (block.comments or self.modal.feed_mode == 930
                          or AXIS_SET.isdisjoint(block.words)):
@@ -390,7 +393,7 @@ class Interpreter:
         if "f" in block.words:
             f = block.words["f"]
             if f < 0:
-                raise block.error("negative feed rate", "f")
+                raise block.error("Negative f word used", "f")
             self.feed_value = f
             if ref:
                 if self.modal.feed_mode != 930:
@@ -402,7 +405,7 @@ class Interpreter:
         if "s" in block.words:
             s = block.words["s"]
             if s < 0:
-                raise block.error("negative spindle speed", "s")
+                raise block.error("Negative spindle speed used", "s")
             self.speed = s
             if ref:
                 self._trace(f"SET_SPINDLE_SPEED(0, {s:.4f})")
@@ -432,13 +435,15 @@ class Interpreter:
         if 10 in ms:
             self._user_m_code(block, ms[10])
         if gs.get(0) == 40:
-            p = self._need(block, "p", "G4")
+            if "p" not in block.words:
+                raise block.error("Dwell time missing with g4", "g4")
+            p = block.words["p"]
             if p < 0:
-                raise block.error("negative dwell time", "p")
+                raise block.error("Dwell time missing with g4", "p")
             self._emit(C.Dwell(p, line))
         if 2 in gs:
             if self.comp.active and gs[2] != self.modal.plane:
-                raise block.error("cannot change the plane with cutter "
+                raise block.error("Cannot change planes with cutter radius "
                                   "compensation on",
                                   code_key("g", gs[2] / 10))
             self.modal.plane = gs[2]
@@ -497,7 +502,7 @@ class Interpreter:
             self._g10(block)
         elif g0 in (280, 300):
             if self.comp.active:
-                raise block.error("G28/G30 while cutter compensation is on",
+                raise block.error("Cannot use g28 or g30 with cutter radius comp",
                                   code_key("g", g0 / 10))
             self._go_home(block, g0)
         elif g0 in (281, 301):
@@ -530,7 +535,8 @@ class Interpreter:
             self._saved = None
         elif code == 720:
             if self._saved is None:
-                raise block.error("M72 without a state saved by M70",
+                raise block.error("Cannot restore context from invalid stack "
+                                  "frame - missing M70/M73?",
                                   "m72")
             self._restore(self._saved, block.line)
         else:
@@ -709,6 +715,48 @@ class Interpreter:
                               what.split()[0].lower())
         return block.words[letter]
 
+    @staticmethod
+    def _arc_turns(block: Block) -> int:
+        """The turns of an arc: its P word, a whole number from 1."""
+        p = block.words.get("p", 1.0)
+        if abs(p - round(p)) > 1e-6:
+            raise block.error("P value not an integer with M19 G2 or G3", "p")
+        if p < 1:
+            raise block.error("P value should be 1 or greater with G2 or G3",
+                              "p")
+        return int(round(p))
+
+    def _g76_words(self, block: Block) -> None:
+        """The words G76 must have, in the reference's order."""
+        w = block.words
+        if w.get("p", -1.0) == -1.0:    # (P-1 reads as no P there)
+            raise block.error("P word missing with G76", "g76")
+        if not any(a in w for a in AXES):
+            raise block.error("All axes missing with motion code", "g76")
+        if any(letter not in w for letter in "ijk"):
+            raise block.error("I J or K words missing with G76", "g76")
+        if "z" not in w:
+            raise block.error("Z word missing with G76", "g76")
+
+    def _arc_message(self, zero: bool, names: str, start: list[float],
+                     end: list[float], centre: tuple[float, float],
+                     a1: int, a2: int) -> str:
+        """The reference's message of an arc whose start and end are not
+        on one circle: the points in program coordinates and units."""
+        middle = list(start)
+        middle[a1], middle[a2] = centre
+        k = self._k()
+        pts = []
+        for machine in (start, middle, end):
+            d = self._unrotated(machine)
+            pts.append(((d[a1] - self.g92[a1]) / k,
+                        (d[a2] - self.g92[a2]) / k))
+        s, c, e = pts
+        r1 = math.dist(s, c)
+        r2 = math.dist(e, c)
+        make = zero_radius_arc if zero else arc_radius_differs
+        return make(names, s, c, e, r1, r2)
+
     def _check(self, block: Block, gs: dict[int, int],
                ms: dict[int, int]) -> None:
         if 10 in ms:
@@ -719,32 +767,38 @@ class Interpreter:
         if g0 in AXIS_USERS_GROUP0 and gs.get(1, 800) != 800:
             # (even without axis words, as the reference)
             raise block.error(
-                f"G{g0 / 10:g} and G{gs[1] / 10:g} both use the axis words",
+                "Cannot use two g codes that both use axis values",
                 code_key("g", gs[1] / 10))
-        if gs.get(1) == 330 and "k" not in block.words:
-            raise block.error("G33 needs a positive K word", "g33")
+        if block.words.get("l", 0.0) < 0:
+            raise block.error("Negative l word used", "l")
+        if gs.get(1) in (20, 30) and "p" in block.words and \
+                0 not in gs and not ms:
+            self._arc_turns(block)      # checked before the line runs
+        if g0 == 920 and not axes:
+            raise block.error("All axes missing with g52 or g92", "g92")
         if gs.get(1) == 760:        # G76 is checked before the line runs
-            for letter in "pzijk":
-                if letter not in block.words:
-                    raise block.error(f"G76 needs the word {letter.upper()}",
-                                      "g76")
+            self._g76_words(block)
         if 1 in gs and not axes and (gs[1] in CANNED or gs[1] in (
                 870, 330, 382, 383, 384, 385, 50, 51)):
-            raise block.error(f"all axes missing with motion code "
-                              f"G{gs[1] / 10:g}", code_key("g", gs[1] / 10))
+            raise block.error("All axes missing with motion code",
+                              code_key("g", gs[1] / 10))
 
         if g0 == 530 and gs.get(1, self.modal.motion) not in (0, 10):
-            raise block.error("G53 needs G0 or G1", "g53")
+            raise block.error("Must use g0 or g1 with g53", "g53")
         if g0 == 530 and gs.get(3, self.modal.distance) == 910:
-            raise block.error("G53 in incremental mode (G91)", "g53")
+            raise block.error("Cannot use g53 incremental", "g53")
         motion = gs.get(1, self.modal.motion)
         if 1 not in gs and motion in (50, 51):
             motion = 800        # a spline is not repeated by axis words
-        if axes and not user0 and gs.get(8) != 431 and motion == 800:
+        g43_2_h = gs.get(8) == 432 and "h" in block.words   # (below)
+        if axes and not user0 and gs.get(8) != 431 and not g43_2_h \
+                and motion == 800:
             raise block.error(
-                f"{axes[0].upper()} word with no G code to use it", axes[0])
+                "Cannot use axis values with g80" if gs.get(1) == 800 else
+                "Cannot use axis values without a g code that uses them",
+                axes[0])
         users: Optional[set[str]] = None
-        for letter in block.words:
+        for letter in sorted(block.words):      # the reference's order
             if letter in ALWAYS_ALLOWED:
                 continue
             if letter == "q" and self.ref and block.words["q"] == -1.0:
@@ -752,8 +806,12 @@ class Interpreter:
             if users is None:
                 users = self._word_users(block, gs, ms, motion)
             if letter not in users:
-                raise block.error(f"{letter.upper()} word with no G or M "
-                                  "code to use it", letter)
+                raise block.error(unused_word(letter), letter)
+        if g43_2_h and axes:
+            raise block.error("G43.2: Can not have both H and axis words",
+                              "g43.2")
+        if gs.get(1) == 330 and "k" not in block.words:
+            raise block.error("K word missing with g33/g33.1", "g33")
 
     def _word_users(self, block: Block, gs: dict[int, int],
                     ms: dict[int, int], motion: int) -> set[str]:
@@ -778,7 +836,11 @@ class Interpreter:
         elif moving and motion == 52:
             allowed |= set("pl")
         elif moving and (motion in CANNED or motion in UNSUPPORTED_MOTION):
-            allowed |= set("rlpq")
+            allowed |= set("rl")
+            if motion in (820, 840, 860, 880, 890):
+                allowed.add("p")        # a dwell
+            if motion in (730, 830):
+                allowed.add("q")        # a peck
             if motion == 870:
                 allowed |= set("ijk")
         if g0 == 40:
@@ -840,7 +902,19 @@ class Interpreter:
 
     def _tool_number(self, block: Block, letter: str) -> int:
         value = block.words[letter]
-        if value < 0 or abs(value - round(value)) > 1e-6:
+        if letter == "q" and value < 0:
+            raise block.error("Need non-negative Q-word to specify tool "
+                              "number with M61", letter)
+        if letter == "t" and value < 0:
+            raise block.error("Negative tool id (tool not found)", letter)
+        if letter == "h" and value < 0:
+            raise block.error(f"Requested tool {value:g} not found in the "
+                              "tool table", letter)
+        if abs(value - round(value)) > 1e-6:
+            raise block.error(
+                "G41 requires D word to be a whole number" if letter == "d"
+                else "Non integer value for integer", letter)
+        if value < 0:
             raise block.error(f"{letter.upper()} must be a non-negative "
                               f"integer, not {value:g}", letter)
         return int(round(value))
@@ -850,7 +924,8 @@ class Interpreter:
             return 0
         pocket = self.tools.pocket_of(tool) if self.tools else None
         if pocket is None:
-            raise block.error(f"tool {tool} is not in the tool table", letter)
+            raise block.error(f"Requested tool {tool} not found in the tool "
+                              "table", letter)
         return int(pocket)
 
     def _select_tool(self, block: Block) -> None:
@@ -882,7 +957,8 @@ class Interpreter:
                 self._load_spindle(pocket)
         else:
             if "q" not in block.words:
-                raise block.error("M61 needs a Q word", "m61")
+                raise block.error("Need non-negative Q-word to specify tool "
+                                  "number with M61", "m61")
             tool = self._tool_number(block, "q")
             pocket = self._pocket_for(block, tool, "q")
             self._emit(C.ChangeToolNumber(tool, pocket, block.line))
@@ -901,8 +977,8 @@ class Interpreter:
     def _cutter_comp(self, block: Block, code: int) -> None:
         key = code_key("g", code / 10)
         if code != 400 and self.modal.plane not in (170, 180):
-            raise block.error("cutter compensation works in the XY and "
-                              "XZ planes (G17, G18) only", key)
+            raise block.error("Cutter radius compensation allowed only in "
+                              "XY, XZ planes", key)
         if code != 400 and "d" in block.words:
             self._pocket_for(block, self._tool_number(block, "d"), "d")
         self._trace('COMMENT("interpreter: cutter radius compensation '
@@ -935,6 +1011,9 @@ class Interpreter:
                 frontangle=0.0, backangle=0.0, orientation=0))
 
     def _tool_length(self, block: Block, code: int) -> None:
+        if self.comp.active:
+            raise block.error("Cannot change tool offset with cutter radius "
+                              "compensation on", code_key("g", code / 10))
         if code == 490:
             offset = [0.0] * 9
         elif code == 431:
@@ -944,7 +1023,8 @@ class Interpreter:
                     offset[i] = block.words[a] * self._k(i)
         else:
             if code == 432 and "h" not in block.words:
-                raise block.error("G43.2 needs an H word", "g43.2")
+                raise block.error("G43.2: No axes specified and H word "
+                                  "missing", "g43.2")
             tool = (self._tool_number(block, "h") if "h" in block.words
                     else self.current_tool)
             if "h" in block.words:
@@ -962,14 +1042,16 @@ class Interpreter:
 
     def _g10_tool(self, block: Block, level: float) -> None:
         if "p" not in block.words:
-            raise block.error(f"G10 L{level:g} needs a P word (tool)", "g10")
+            raise block.error(f"P value out of range with G10 L{level:g}",
+                              "g10")
         tool = self._tool_number(block, "p")
         if self.random and tool == self.current_tool:
             pocket = 0
         else:
             pocket = self._pocket_for(block, tool, "p")
             if pocket == 0 and not self.random:
-                raise block.error("G10 L1 cannot change tool 0", "p")
+                raise block.error(f"P value out of range with G10 "
+                                  f"L{level:g}", "p")
         entry = self.tools.entry(pocket)
         offset = list(entry.offset)
         for i, a in enumerate(AXES):
@@ -1016,7 +1098,7 @@ class Interpreter:
 
     def _index(self, block: Block, letter: str, what: str) -> int:
         if letter not in block.words:
-            raise block.error(f"{what} needs a {letter.upper()} word",
+            raise block.error(f"No valid {letter.upper()} word with {what}",
                               what.split()[0].lower())
         value = block.words[letter]
         if value < 0 or abs(value - round(value)) > 1e-6:
@@ -1033,7 +1115,8 @@ class Interpreter:
             self._emit(cls(index, on, line))
         elif code == 660:
             if ("p" in block.words) == ("e" in block.words):
-                raise block.error("M66 needs exactly one of P and E", "m66")
+                raise block.error("Invalid to select both a digital and an "
+                                  "analog input with M66", "m66")
             digital = "p" in block.words
             index = self._index(block, "p" if digital else "e", "M66")
             mode = int(block.words.get("l", 0))
@@ -1133,21 +1216,26 @@ class Interpreter:
     # -- offsets ---------------------------------------------------------
     def _g10(self, block: Block) -> None:
         if "l" not in block.words:
-            raise block.error("G10 needs an L word", "g10")
+            raise block.error("Line with G10 does not have L0, L1, L10, "
+                              "L11, L2, or L20", "g10")
         level = block.words["l"]
         if level in (1, 10, 11):
             self._g10_tool(block, level)
             return
         if level not in (2, 20):
-            raise block.error(f"G10 L{level:g} is not supported", "l")
+            raise block.error("Line with G10 does not have L0, L1, L10, "
+                              "L11, L2, or L20", "l")
         if "i" in block.words or "j" in block.words:
-            raise block.error("I and J words are not allowed with G10 "
-                              f"L{level:g}", "g10")
+            # (the reference says L2 for L20 too)
+            raise block.error("I J words not allowed with G10 L2", "g10")
         if level == 20 and "r" in block.words:
-            raise block.error("R is not allowed with G10 L20", "r")
-        p = self._index(block, "p", "G10 L2/L20")
-        if p > 9:
-            raise block.error(f"G10 P{p}: coordinate systems are 0..9", "p")
+            raise block.error("R not allowed in G10 L20", "r")
+        p = block.words.get("p", -1.0)
+        if not 0 <= p <= 9 or abs(p - round(p)) > 1e-6:
+            raise block.error("P value out of range (0-9) with G10 "
+                              f"L{level:g}", "p" if "p" in block.words
+                              else "g10")
+        p = int(round(p))
         index = p or self.coord_index
         base = 5201 + 20 * index
         angle = float(self.params.get(base + 9))
@@ -1179,7 +1267,7 @@ class Interpreter:
     def _g92(self, block: Block, code: int) -> None:
         if code == 920:
             if not self._axis_words(block):
-                raise block.error("G92 needs at least one axis word", "g92")
+                raise block.error("All axes missing with g52 or g92", "g92")
             here = self._unrotated(self.pos)
             for i, a in enumerate(AXES):
                 if a in block.words:
@@ -1220,15 +1308,21 @@ class Interpreter:
     def _feed_for(self, block: Block, length: float) -> float:
         if self.modal.feed_mode == 930:
             if "f" not in block.words:
-                raise block.error("inverse time feed (G93) needs an F word "
-                                  "on every feed move", "")
+                raise block.error("F word missing with inverse time "
+                                  f"{self._move_name()} move", "")
             f = block.words["f"]
             if f <= 0:
                 raise block.error("inverse time F must be positive", "f")
             return length * f if length > 0 else f
         if self.feed <= 0:
-            raise block.error("feed move with zero feed rate", "")
+            raise block.error("Cannot make arc with zero feed rate"
+                              if self._move_name() == "arc" else
+                              "Cannot do g1 with zero feed rate", "")
         return self.feed
+
+    def _move_name(self) -> str:
+        """How the reference names the current move in its messages."""
+        return "arc" if self.modal.motion in (20, 30, 50, 51) else "g1"
 
     def _inverse_time_trace(self, length: float) -> None:
         """G93: the reference sets the feed rate of each move."""
@@ -1272,9 +1366,16 @@ class Interpreter:
             return
         g53 = gs.get(0) == 530
         if self.comp.active and (motion not in (0, 10, 20, 30) or g53):
-            raise block.error(f"G{'53' if g53 else f'{motion / 10:g}'} "
-                              "while cutter compensation is on is not "
-                              "supported", "g53" if g53 else key)
+            if g53:
+                text = "Cannot use g53 with cutter radius comp"
+            elif motion in CANNED or motion == 870:
+                text = "Cannot use canned cycles with cutter compensation on"
+            elif 382 <= motion <= 385:
+                text = "Cannot probe with cutter radius comp on"
+            else:
+                text = (f"G{motion / 10:g} while cutter compensation is on "
+                        "is not supported")
+            raise block.error(text, "g53" if g53 else key)
         if self.comp.active and has_axes and motion in (0, 10):
             end = self._target(block)
             feed = None
@@ -1287,7 +1388,7 @@ class Interpreter:
             self.pos = end
             return
         if g53 and self.modal.distance == 910:
-            raise block.error("G53 in incremental mode (G91)", "g53")
+            raise block.error("Cannot use g53 incremental", "g53")
         if motion in (0, 10, 330) or 382 <= motion <= 385:
             if not has_axes:
                 # the reference moves to where it is on a G0/G1 alone
@@ -1302,7 +1403,7 @@ class Interpreter:
                 self._straight_feed(block, end)
             elif motion == 330:
                 if "k" not in block.words or block.words["k"] <= 0:
-                    raise block.error("G33 needs a positive K word", key)
+                    raise block.error("K word missing with g33/g33.1", key)
                 self._emit(C.SyncedFeed(_pose(end), self._len(
                     block.words["k"]), line))
                 self.pos = end
@@ -1325,9 +1426,9 @@ class Interpreter:
         key = code_key("g", motion / 10)
         w = block.words
         if self.modal.plane != 170:
-            raise block.error("splines must be in the XY plane (G17)", key)
+            raise block.error("Splines must be in the XY plane", key)
         if any(a in w for a in "zabcuvw"):
-            raise block.error("splines may not move Z, A, B, C, U, V or W",
+            raise block.error("Splines may not have motion in Z, A, B, or C",
                               key)
         k = self._k()
         start = list(self.pos)
@@ -1336,7 +1437,7 @@ class Interpreter:
         p3 = (end[0], end[1])
         if motion == 50:
             if "p" not in w or "q" not in w:
-                raise block.error("G5 needs both P and Q", key)
+                raise block.error("Must specify both P and Q with G5", key)
             if "i" in w or "j" in w:
                 c1 = (w.get("i", 0.0) * k, w.get("j", 0.0) * k)
             elif self._previous_motion == 50:
@@ -1353,7 +1454,7 @@ class Interpreter:
             self._spline_pq = pq
         else:
             if "i" not in w or "j" not in w:
-                raise block.error("G5.1 needs both I and J", key)
+                raise block.error("Must specify both I and J with G5.1", key)
             c1 = (w["i"] * k, w["j"] * k)
             if self.rotation:
                 c1 = _rotate(c1[0], c1[1], self.rotation)
@@ -1504,10 +1605,7 @@ class Interpreter:
         X and the end Z."""
         key = "g76"
         w = block.words
-        for letter in "pzijk":
-            if letter not in w:
-                raise block.error(f"G76 needs the word {letter.upper()}",
-                                  key)
+        self._g76_words(block)
         k = self._k()
         half = 0.5 if self.diameter_mode else 1.0
         pitch = w["p"] * k
@@ -1519,8 +1617,10 @@ class Interpreter:
         springs = int(w.get("h", 0))
         taper = w.get("e", 0.0) * k
         ends = int(w.get("l", 0))
-        if pitch <= 0 or depth0 <= 0 or full <= 0:
-            raise block.error("G76 needs positive P, J and K", key)
+        for letter, value in (("p", pitch), ("j", depth0), ("k", full)):
+            if value <= 0:
+                raise block.error(f"In G76, {letter.upper()} must be greater "
+                                  "than 0", letter)
         if degression < 1.0:
             raise block.error("G76 R (depth degression) must be at least 1",
                               "r")
@@ -1589,12 +1689,12 @@ class Interpreter:
     def _probe(self, block: Block, motion: int, end: list[float]) -> None:
         key = code_key("g", motion / 10)
         if self.modal.feed_mode == 930:
-            raise block.error("G38.x cannot be used in inverse time mode",
-                              key)
+            # (the reference probes at the G94 feed rate)
+            raise block.error("Cannot probe with zero feed rate", key)
         if self.feed <= 0:
-            raise block.error("G38.x with zero feed rate", key)
+            raise block.error("Cannot probe with zero feed rate", key)
         if math.dist(self.pos, end) < 1e-9:
-            raise block.error("G38.x probe move has zero length", key)
+            raise block.error("Start point too close to probe point", key)
         self._emit(C.Probe(_pose(end), f"{motion / 10:g}", self.feed,
                            block.line))
         self.pos = list(end)
@@ -1605,14 +1705,18 @@ class Interpreter:
         other = {170: "k", 180: "j", 190: "i"}[self.modal.plane]
         words = block.words
         if "r" in words and any(w in words for w in "ijk"):
-            raise block.error("mixed radius and IJK format for an arc", "r")
+            raise block.error("Mixed radius ijk format for arc", "r")
         if not ("r" in words or any(w in words for w in "ijk")):
-            raise block.error("R, I, J and K words all missing for an arc",
-                              key)
+            raise block.error("R i j k words all missing for arc", key)
         if other in block.words and "r" not in block.words:
-            raise block.error(f"{other.upper()} word given for an arc in the "
-                              f"{ {'k': 'XY', 'j': 'XZ', 'i': 'YZ'}[other]} "
-                              "plane", other)
+            raise block.error(f"{other.upper()} word given for arc in "
+                              f"{PLANE_NAME[self.modal.plane]} plane", other)
+        turns = self._arc_turns(block)
+        if self.modal.feed_mode == 930 and "f" not in block.words:
+            raise block.error("F word missing with inverse time arc move",
+                              key)
+        if self.modal.feed_mode != 930 and self.feed <= 0:
+            raise block.error("Cannot make arc with zero feed rate", key)
         if self.rotation and self.modal.plane != 170:
             raise block.error("arcs outside G17 in a rotated coordinate "
                               "system (G10 L2 R) are not supported", key)
@@ -1627,19 +1731,18 @@ class Interpreter:
             if any(w in block.words for w in centre_words):
                 raise block.error("arc with both R and centre words", "r")
             if not in_plane:
-                raise block.error(f"{names[0]} and {names[1]} words both "
-                                  "missing for a radius-format arc", key)
+                raise block.error(f"{names[0]} and {names[1].lower()} words "
+                                  "missing for arc in "
+                                  f"{PLANE_NAME[self.modal.plane]} plane", key)
             r = block.words["r"] * k
             chord = math.hypot(e1 - s1, e2 - s2)
             if chord < 1e-9:
-                raise block.error("full circle cannot be given with R; use "
-                                  "centre words", "r")
-            if abs(r) < 1e-9:
-                raise block.error("zero radius arc", "r")
+                raise block.error("Current point same as end point of arc",
+                                  "r")
             half = chord / 2
-            if abs(r) < half - tol:
-                raise block.error(f"arc radius {abs(block.words['r']):g} too "
-                                  "small to reach the end point", "r")
+            if abs(r) < 1e-9 or abs(r) < half - tol:
+                raise block.error("Arc radius too small to reach end point",
+                                  "r")
             h = math.sqrt(max(r * r - half * half, 0.0))
             sign = 1.0 if (motion == 30) != (r < 0) else -1.0
             m1, m2 = (s1 + e1) / 2, (s2 + e2) / 2
@@ -1653,9 +1756,9 @@ class Interpreter:
             o1, o2 = block.words.get(w1, 0.0) * k, block.words.get(w2, 0.0) * k
             if self.modal.arc_distance == 901:
                 if w1 not in block.words or w2 not in block.words:
-                    raise block.error(
-                        f"absolute arc centres (G90.1) need both "
-                        f"{w1.upper()} and {w2.upper()}", key)
+                    missing = w1 if w1 not in block.words else w2
+                    raise block.error(f"{missing.upper()} word missing in "
+                                      "absolute center arc", key)
                 point = self.program_position()
                 point[a1], point[a2] = o1, o2
                 centre = self._to_machine(point)
@@ -1666,19 +1769,11 @@ class Interpreter:
                 c1, c2 = s1 + o1, s2 + o2
             r1 = math.hypot(s1 - c1, s2 - c2)
             r2 = math.hypot(e1 - c1, e2 - c2)
-            if r1 < 1e-9:
-                raise block.error("zero radius arc", key)
-            if abs(r1 - r2) > tol and abs(r1 - r2) > 0.001 * r1:
-                raise block.error(
-                    f"radius to end of arc differs from radius to start "
-                    f"by {abs(r1 - r2) / k:.4g}", key)
-        turns = 1
-        if "p" in block.words:
-            p = block.words["p"]
-            if p < 1 or abs(p - round(p)) > 1e-6:
-                raise block.error("arc P (turns) must be a positive integer",
-                                  "p")
-            turns = int(round(p))
+            if r1 < tol or r2 < tol or (abs(r1 - r2) > tol
+                                        and abs(r1 - r2) > 0.001 * r1):
+                raise block.error(self._arc_message(
+                    r1 < tol or r2 < tol, names, start, end, (c1, c2),
+                    a1, a2), key)
         turn = turns if motion == 30 else -turns
         length = self._arc_length(start, end, (c1, c2), a1, a2, turn)
         feed = self._feed_for(block, length)
@@ -1725,20 +1820,22 @@ class Interpreter:
                 self.cycle[letter] = block.words[letter]
         for letter in ("r", dl):
             if letter not in self.cycle:
-                raise block.error(f"canned cycle G{motion / 10:g} needs "
-                                  f"the word {letter.upper()}", key)
+                raise block.error(
+                    "R clearance plane unspecified in cycle" if letter == "r"
+                    else f"{letter.upper()} value unspecified in "
+                    f"{PLANE_NAME[self.modal.plane]} plane canned cycle", key)
         if motion in (730, 830) and self.cycle.get("q", 0) <= 0 and \
                 not self.ref:
-            raise block.error(f"G{motion / 10:g} needs a positive Q word",
-                              key)
+            raise block.error(f"Q word missing with g{motion // 10}", key)
         if motion == 840 and self.modal.spindle != 30 and not self.ref:
-            raise block.error("G84 needs the spindle turning clockwise (M3)",
-                              key)
+            raise block.error("Spindle not turning in G84"
+                              if self.modal.spindle == 50 else
+                              "Spindle turning counterclockwise in G84", key)
         if motion == 880 and self.modal.spindle == 50 and not self.ref:
-            raise block.error("G88 needs the spindle turning", key)
+            raise block.error("Spindle not turning in g88", key)
         repeats = int(block.words.get("l", 1))
         if repeats < 0:
-            raise block.error("L must not be negative", "l")
+            raise block.error("Negative l word used", "l")
         k = self._k()
         prog = self.program_position()
         old = prog[d]
@@ -1751,12 +1848,11 @@ class Interpreter:
         r = self.cycle["r"] * k + (old if incremental else 0.0)
         bottom = self.cycle[dl] * k + (r if incremental else 0.0)
         if bottom > r:
-            raise block.error("canned cycle R plane is below the bottom "
-                              f"({dl.upper()})", "r")
+            raise block.error(f"R less than {dl} in cycle in "
+                              f"{PLANE_NAME[self.modal.plane]} plane", "r")
         clear = max(old, r) if self.modal.retract == 980 else r
         if self.feed <= 0 or self.modal.feed_mode == 930:
-            raise block.error("canned cycle needs a feed rate in G94 mode",
-                              key)
+            raise block.error("Cannot feed with zero feed rate", key)
         if old < r:
             prog[d] = r
             self._traverse(self._to_machine(prog), line)
@@ -1766,15 +1862,15 @@ class Interpreter:
         if self.ref and motion == 870:
             for letter in "ijk":
                 if letter not in self.cycle:
-                    raise block.error(f"G87 needs the word {letter.upper()}",
-                                      key)
+                    raise block.error(f"{letter.upper()} word missing with "
+                                      "g87", key)
         if self.ref and motion in (730, 830) and \
                 self.cycle.get("q", 0) <= 0:
-            raise block.error(f"Q word missing with G{motion // 10}", key)
+            raise block.error(f"Q word missing with g{motion // 10}", key)
         if self.ref and motion in (820, 860, 880, 890) and \
                 "p" not in self.cycle:
-            raise block.error("dwell time P word missing with "
-                              f"G{motion // 10}", key)
+            raise block.error("Dwell time p word missing with "
+                              f"g{motion // 10}", key)
         for _ in range(repeats):
             for axis in (a1, a2):
                 letter = AXES[axis]
@@ -1817,7 +1913,9 @@ class Interpreter:
         if motion == 840 and self.modal.spindle != 30:
             block = self.line_block
             assert block is not None
-            raise block.error("G84 needs the spindle turning clockwise (M3)",
+            raise block.error("Spindle not turning in G84"
+                              if self.modal.spindle == 50 else
+                              "Spindle turning counterclockwise in G84",
                               code_key("g", 84))
         if motion == 840:
             self._trace("DISABLE_FEED_OVERRIDE()")

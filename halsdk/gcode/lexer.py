@@ -223,11 +223,11 @@ def _paren_comment(text: str, i: int, file: str, lineno: int
     after its ``)``."""
     end = text.find(")", i + 1)
     if end < 0:
-        raise GCodeError("unclosed comment: '(' without ')'",
+        raise GCodeError("Unclosed comment found",
                          file, lineno, i + 1)
     nested = text.find("(", i + 1, end)
     if nested >= 0:
-        raise GCodeError("nested comment: '(' inside a comment",
+        raise GCodeError("Nested comment found",
                          file, lineno, nested + 1)
     return _comment(text[i + 1:end], i + 1), end + 1
 
@@ -281,7 +281,7 @@ def _read_line(reader: _Reader, line: Line) -> Line:
     if reader.peek() == "%":
         reader.take()
         if not reader.at_end():
-            raise reader.error("nothing may follow '%' on its line")
+            raise reader.error("Bad character '%' used")
         line.percent = True
         return line
     if reader.peek() == "/":
@@ -293,7 +293,7 @@ def _read_line(reader: _Reader, line: Line) -> Line:
     if reader.peek() == "o":
         line.oword = _oword(reader)
         if not reader.at_end():
-            raise reader.error(f"unexpected '{reader.peek()}' after o-word")
+            raise reader.error("Unexpected character after O-word")
         return line
     seen: dict[str, int] = {}
     while not reader.at_end():
@@ -302,26 +302,27 @@ def _read_line(reader: _Reader, line: Line) -> Line:
         if char == "#":
             target = _parameter(reader)
             if reader.peek() != "=":
-                raise reader.error("expected '=' after a parameter at the "
-                                   "start of a word")
+                raise reader.error("Equal sign missing in parameter setting")
             reader.take()
             line.assignments.append(
                 Assignment(target, _real_value(reader), column))
             continue
         if char not in WORD_LETTERS:
             if char == "o":
-                raise reader.error("an o-word must start its line")
+                raise reader.error("Bad character 'o' used")
             if char.isalpha():
                 raise reader.error(f"unknown word letter '{char.upper()}'")
-            raise reader.error(f"unexpected character '{char}'")
+            if char in "$^":
+                raise reader.error("No characters found in reading real "
+                                   "value")
+            raise reader.error(f"Bad character '{char}' used")
         reader.take()
         if char == "n":
-            raise reader.error("line number N must start the line", column)
+            raise reader.error("Bad character 'n' used", column)
         if char not in "gm":
             if char in seen:
-                raise reader.error(
-                    f"two {char.upper()} words on one line "
-                    f"(first at column {seen[char]})", column)
+                raise reader.error(f"Multiple {char} words on one line",
+                                   column)
             seen[char] = column
         line.words.append(Word(char, _real_value(reader), column))
     return line
@@ -338,7 +339,7 @@ def _unsigned_number(reader: _Reader) -> float:
     try:
         return float(digits)
     except ValueError:
-        raise reader.error("bad number", start) from None
+        raise reader.error("Bad format unsigned integer", start) from None
 
 
 def _number(reader: _Reader) -> Number:
@@ -359,17 +360,22 @@ def _number(reader: _Reader) -> Number:
         char = reader.take()
         if char == ".":
             if seen_dot:
-                raise reader.error("bad number: a second decimal point",
-                                   reader.column_at(reader.pos - 1))
+                column = reader.column_at(reader.pos - 1)
+                text += char
+                while reader.peek().isdigit() or reader.peek() == ".":
+                    text += reader.take()
+                raise reader.error("bad number format (trailing characters) "
+                                   f"parsing '{text}'", column)
             seen_dot = True
         else:
             digits += 1
         text += char
     if not digits:
-        found = reader.peek()
-        what = f"'{found}'" if found else "end of line"
-        raise reader.error(f"bad number: expected a number, found {what}",
-                           start)
+        if not text and reader.at_end():
+            raise reader.error("No characters found in reading real value",
+                               start)
+        raise reader.error("bad number format (conversion failed) parsing "
+                           f"'{text}'", start)
     return Number(float(text), start)
 
 
@@ -403,10 +409,11 @@ def _bracketed(reader: _Reader) -> Expr:
     value = _expression(reader, 1)
     if reader.peek() != "]":
         if reader.at_end():
-            raise reader.error("unclosed bracket: '[' without ']'",
-                               open_column)
-        raise reader.error(f"expected an operator or ']', found "
-                           f"'{reader.peek()}'")
+            raise reader.error("Unclosed expression", open_column)
+        if reader.peek().isalpha():
+            raise reader.error("Unknown operation name starting with "
+                               f"{reader.peek()}")
+        raise reader.error("Unknown operation")
     reader.take()
     return value
 
@@ -450,13 +457,14 @@ def _function(reader: _Reader) -> Expr:
             name += reader.take()
     if name == "atan":
         if reader.peek() != "[":
-            raise reader.error("ATAN needs [y]/[x]")
+            raise reader.error("Left bracket missing after unary operation "
+                               "name")
         y = _bracketed(reader)
         if reader.peek() != "/":
-            raise reader.error("ATAN needs '/[x]' after its first argument")
+            raise reader.error("Slash missing after first atan argument")
         reader.take()
         if reader.peek() != "[":
-            raise reader.error("ATAN needs [x] after '/'")
+            raise reader.error("Left bracket missing after slash with atan")
         return Atan(y, _bracketed(reader), column)
     if name == "exists":
         if reader.peek() != "[":
@@ -464,7 +472,7 @@ def _function(reader: _Reader) -> Expr:
         open_column = reader.column()
         reader.take()
         if not (reader.peek() == "#" and reader.peek(1) == "<"):
-            raise reader.error("EXISTS takes one named parameter #<name>")
+            raise reader.error("Expected # reading parameter")
         reader.take()
         target = _name(reader)
         if reader.peek() != "]":
@@ -475,9 +483,11 @@ def _function(reader: _Reader) -> Expr:
         reader.take()
         return Exists(target, column)
     if name not in FUNCTIONS:
-        raise reader.error(f"unknown function '{name.upper()}'", column)
+        raise reader.error(f"Unknown word starting with {name[:1]}",
+                           column)
     if reader.peek() != "[":
-        raise reader.error(f"{name.upper()} needs an argument in [ ]")
+        raise reader.error("Left bracket missing after unary operation "
+                           "name")
     return Function(name, _bracketed(reader), column)
 
 
@@ -495,11 +505,11 @@ def _name(reader: _Reader) -> str:
         while not reader.at_end() and reader.peek() != ">":
             name += reader.take()
     if reader.at_end():
-        raise reader.error("unclosed parameter name: '<' without '>'",
+        raise reader.error("Named parameter not terminated",
                            open_column)
     reader.take()
     if not name:
-        raise reader.error("empty parameter name", open_column)
+        raise reader.error("Named parameter #<> not defined", open_column)
     return name
 
 
@@ -516,8 +526,9 @@ def _parameter(reader: _Reader) -> ParamRef:
         return ParamRef(_bracketed(reader), column)
     if char.isdigit():
         return ParamRef(_number(reader), column)
-    raise reader.error("expected a parameter number, #, [ or <name> "
-                       "after '#'")
+    if char == "-":
+        raise reader.error("Parameter number out of range")
+    raise reader.error("bad number format (conversion failed) parsing ''")
 
 
 def _oword(reader: _Reader) -> OWord:
@@ -532,7 +543,7 @@ def _oword(reader: _Reader) -> OWord:
         number = _unsigned_number(reader)
         name = f"{number:g}"
     else:
-        raise reader.error("expected an o-word number or <name> after 'O'")
+        raise reader.error("No characters found in reading real value")
     keyword_column = reader.column()
     if isinstance(reader, _AsciiReader):
         keyword = reader.match(_WORD)
@@ -541,17 +552,17 @@ def _oword(reader: _Reader) -> OWord:
         while reader.peek().isalpha():
             keyword += reader.take()
     if keyword not in O_KEYWORDS:
-        text = f"'{keyword}'" if keyword else "nothing"
-        raise reader.error(f"unknown o-word keyword {text}", keyword_column)
+        raise reader.error("Unknown control command in o word",
+                           keyword_column)
     args: list[Expr] = []
     if keyword in ("if", "elseif", "while", "repeat", "return", "endsub",
                    "call"):
         while reader.peek() == "[":
             args.append(_bracketed(reader))
     if keyword in ("if", "elseif", "while", "repeat") and len(args) != 1:
-        raise reader.error(f"O {keyword} needs one [condition]"
-                           if keyword != "repeat" else
-                           "O repeat needs one [count]")
+        raise reader.error(f"Left bracket missing after '{keyword}'"
+                           if not args else
+                           "Unexpected character after O-word")
     if keyword in ("return", "endsub") and len(args) > 1:
-        raise reader.error(f"O {keyword} takes at most one [value]")
+        raise reader.error("Unexpected character after O-word")
     return OWord(name, keyword, args, column)

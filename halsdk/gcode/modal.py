@@ -65,18 +65,24 @@ def _by_group(block: Block, letter: str, values: Iterable[float],
               groups: dict[int, int]) -> dict[int, int]:
     """Map group -> code (tenths) of the ``letter`` codes ``values``."""
     found: dict[int, int] = {}
-    word = letter.upper()
     for value in values:
         code = int(round(value * 10))
         name = code_key(letter, value)
         if code not in groups:
-            raise block.error(f"unknown or unsupported {word} code "
-                              f"{word}{name[1:]}", name)
+            raise block.error(f"Unknown m code used: M{name[1:]}"
+                              if letter == "m" else "Unknown g code used",
+                              name)
         group = groups[code]
+        if letter == "g" and group == 1 and 1 in found and \
+                800 in (code, found[1]):
+            # G80 beside another motion code: the other one, as the
+            # reference does
+            if code == 800:
+                continue
+            del found[1]
         if group in found:
-            raise block.error(
-                f"two {word} codes of modal group {group} in one block "
-                f"({word}{found[group] / 10:g} and {word}{name[1:]})", name)
+            raise block.error(f"Two {letter} codes used from same modal "
+                              "group", name)
         found[group] = code
     return found
 

@@ -121,10 +121,9 @@ class Parameters:
     def _number(self, key: float) -> int:
         number = int(round(key))
         if abs(number - key) > 1e-4:
-            raise GCodeError(f"parameter number {key:g} is not an integer")
+            raise GCodeError("Non integer value for integer")
         if not 1 <= number <= MAX_PARAMETER:
-            raise GCodeError(f"parameter number {number} out of range "
-                             f"1..{MAX_PARAMETER}")
+            raise GCodeError("Parameter number out of range")
         return number
 
     def get(self, key: Key) -> float:
@@ -137,7 +136,7 @@ class Parameters:
             table = self._globals if name.startswith("_") \
                 else self._frames[-1].named
             if name not in table:
-                raise GCodeError(f"named parameter #<{name}> is not defined")
+                raise GCodeError(f"Named parameter #<{name}> not defined")
             return table[name]
         number = self._number(key)
         if number in LOCAL_NUMBERED and self.depth:
@@ -172,7 +171,8 @@ class Parameters:
             if not name:
                 raise GCodeError("empty parameter name")
             if self._predefined_value(name) is not None:
-                raise GCodeError(f"named parameter #<{name}> is read-only")
+                raise GCodeError("Cannot assign to read-only parameter "
+                                 f"#<{name}>")
             if name.startswith("_"):
                 self._globals[name] = value
             else:
@@ -180,7 +180,7 @@ class Parameters:
             return
         number = self._number(key)
         if not internal and (number in READ_ONLY or number in POSITION):
-            raise GCodeError(f"parameter #{number} is read-only")
+            raise GCodeError("Parameter is readonly")
         if number in LOCAL_NUMBERED and self.depth:
             self._frames[-1].numbered[number] = value
         else:

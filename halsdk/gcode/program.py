@@ -342,6 +342,18 @@ def _scan(unit: _Unit) -> _Structure:
         assert line.oword is not None
         return GCodeError(message, unit.file, line.number, line.oword.column)
 
+    def unmatched(index: int, wanted: tuple[str, ...], name: str
+                  ) -> GCodeError:
+        """The reference's words for an o-word without its opener."""
+        line = unit.owords[index]
+        for kind, open_name, opener in reversed(stack):
+            if open_name == name and kind not in wanted:
+                return fail(index, f"{line.number}: no matching label: "
+                                   f"'{line.text}' (found '{kind}' in line "
+                                   f"{unit.owords[opener].number})")
+        return fail(index, f"{line.number}: undefined O-word label: "
+                           f"'{line.text}'")
+
     for index in sorted(unit.owords):
         oword = unit.owords[index].oword
         assert oword is not None
@@ -349,14 +361,18 @@ def _scan(unit: _Unit) -> _Structure:
         label = _label(name)
         if keyword == "sub":
             if current_sub is not None:
-                raise fail(index, f"{label} sub inside subroutine "
-                                  f"o<{current_sub[0]}>")
+                raise fail(index, "Nested subroutine definition")
             if name in result.subs:
-                raise fail(index, f"{label} sub defined twice")
+                raise fail(index, f"File:{unit.file} line:"
+                                  f"{unit.owords[index].number} redefining "
+                                  f"sub: o|{name}| already defined in "
+                                  f"file:{unit.file}")
             current_sub = (name, index)
         elif keyword == "endsub":
             if current_sub is None:
-                raise fail(index, f"{label} endsub without sub")
+                raise fail(index, f"{unit.owords[index].number}: not in a "
+                                  "subroutine definition: "
+                                  f"'{unit.owords[index].text}'")
             if stack:
                 kind, open_name, _ = stack[-1]
                 raise fail(index, f"{label} endsub before the end of "
@@ -370,14 +386,15 @@ def _scan(unit: _Unit) -> _Structure:
             current_sub = None
         elif keyword == "return":
             if current_sub is None or current_sub[0] != name:
-                raise fail(index, f"{label} return outside subroutine "
-                                  f"{label}")
+                raise fail(index, f"{unit.owords[index].number}: not in a "
+                                  "subroutine definition: "
+                                  f"'{unit.owords[index].text}'")
         elif keyword == "if":
             stack.append(("if", name, index))
             result.branches[index] = []
         elif keyword in ("elseif", "else", "endif"):
             if not stack or stack[-1][0] != "if" or stack[-1][1] != name:
-                raise fail(index, f"{label} {keyword} without {label} if")
+                raise unmatched(index, ("if",), name)
             opener = stack[-1][2]
             branches = result.branches[opener]
             if branches and unit.keyword(branches[-1]) == "else" \
@@ -399,8 +416,7 @@ def _scan(unit: _Unit) -> _Structure:
         elif keyword in ("endwhile", "endrepeat"):
             wanted = keyword[3:]
             if not stack or stack[-1][0] != wanted or stack[-1][1] != name:
-                raise fail(index, f"{label} {keyword} without {label} "
-                                  f"{wanted}")
+                raise unmatched(index, (wanted,), name)
             opener = stack.pop()[2]
             result.loop_end[opener] = index
             result.loop_start[index] = opener
@@ -408,7 +424,7 @@ def _scan(unit: _Unit) -> _Structure:
             loops = [entry for entry in stack
                      if entry[0] in _LOOP_OPENERS and entry[1] == name]
             if not loops:
-                raise fail(index, f"{label} {keyword} outside loop {label}")
+                raise unmatched(index, _LOOP_OPENERS, name)
             result.loop_of[index] = loops[-1][2]
         elif keyword == "call":
             pass
@@ -419,8 +435,9 @@ def _scan(unit: _Unit) -> _Structure:
         raise fail(index, f"{_label(name)} {kind} without {_label(name)} "
                           f"{closer}")
     if current_sub is not None:
-        raise fail(current_sub[1],
-                   f"{_label(current_sub[0])} sub without endsub")
+        # (the reference reads on to the end, looking for the endsub)
+        raise GCodeError("File ended with no percent sign or program end",
+                         unit.file, unit.count, 1)
     return result
 
 
@@ -664,6 +681,10 @@ class Program:
             assert isinstance(entry, Line)
             line = entry
             if line.percent:
+                if seen_code and unit.percents[0] == index:
+                    # only a program opened with '%' may close with one
+                    raise GCodeError("Bad character '%' used", line.file,
+                                     line.number, line.text.find("%") + 1)
                 if seen_code or unit.percents and unit.percents[0] < index:
                     return
                 index += 1
@@ -707,16 +728,18 @@ class Program:
                     continue
                 target = self._find_sub(name, unit)
                 if target is None:
-                    raise GCodeError(f"unknown subroutine {_label(name)}",
-                                     line.file, line.number, oword.column)
+                    # (the reference reads on to the end, looking for it)
+                    raise GCodeError(f"EOF in file:{unit.file} seeking "
+                                     f"o-word: o<{name}> from line: "
+                                     f"{line.number}", unit.file,
+                                     unit.count, 1)
                 if len(frames) >= self.max_call_depth:
-                    raise GCodeError(f"subroutine calls nested deeper than "
-                                     f"{self.max_call_depth}", line.file,
+                    raise GCodeError("Too many subroutine levels", line.file,
                                      line.number, oword.column)
                 self._count(unit, index, "subroutine call")
                 args = [self._value(a, line) for a in oword.args]
                 if len(args) > 30:
-                    raise GCodeError("at most 30 subroutine arguments",
+                    raise GCodeError("Too many subroutine parameters",
                                      line.file, line.number, oword.column)
                 self.params.set("_value_returned", 0.0)
                 self.params.push_scope(args)

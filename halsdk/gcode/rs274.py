@@ -94,9 +94,15 @@ def _finished_with_percent(text: str) -> bool:
 
 
 def _source_line(text: str, file: str, exc: GCodeError) -> Optional[str]:
-    """The line an error is about, when it is in the main program."""
+    """The line an error is about (in the program or a subroutine file)."""
+    if exc.file != file:
+        try:
+            with open(exc.file, encoding="utf-8") as f:
+                text = f.read()
+        except (OSError, UnicodeDecodeError):
+            return None
     lines = text.splitlines()
-    if exc.file == file and 1 <= exc.line <= len(lines):
+    if 1 <= exc.line <= len(lines):
         return lines[exc.line - 1]
     return None
 
@@ -172,8 +178,8 @@ def run(text: str, file: str, write: Callable[[str], Any],
         if not interp.ended:
             if not _finished_with_percent(text):
                 lines = text.splitlines()
-                raise GCodeError("file ended with no percent sign or "
-                                 "program end", file, len(lines))
+                raise GCodeError("File ended with no percent sign or "
+                                 "program end", file, len(lines), 1)
             canon.call("FINISH()")
     except GCodeError as exc:
         report(exc)

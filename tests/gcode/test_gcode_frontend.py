@@ -359,36 +359,48 @@ def test_endless_loop_is_an_error_naming_the_loop() -> None:
 # -- errors --------------------------------------------------------------------
 
 @pytest.mark.parametrize("text, expected", [
-    ("g1 &5", "t.ngc:1:4: unexpected character '&'"),
-    ("g1 x1 y2 X3", "t.ngc:1:10: two X words"),
-    ("g1 x1.2.3", "t.ngc:1:8: bad number"),
-    ("g1 x", "t.ngc:1:5: bad number"),
-    ("g1 x-", "t.ngc:1:5: bad number"),
-    ("g1 (open comment", "t.ngc:1:4: unclosed comment"),
-    ("g1 (a (b) c)", "t.ngc:1:7: nested comment"),
-    ("g1 x[1+[2*3]", "t.ngc:1:5: unclosed bracket"),
-    ("g1 x[1 g 2]", "t.ngc:1:8: expected an operator or ']'"),
-    ("g0\ng1 x[4/[2-2]]", "t.ngc:2:7: division by zero"),
-    ("g1 x[5 mod 0]", "t.ngc:1:8: division by zero"),
-    ("g1 x[foo[2]]", "t.ngc:1:6: unknown function 'FOO'"),
-    ("g1 x[sqrt[-1]]", "t.ngc:1:6: SQRT of a negative number"),
-    ("g1 x#<undefined>", "t.ngc:1:5: named parameter #<undefined> is not"),
-    ("#<a=1", "t.ngc:1:2: unclosed parameter name"),
-    ("#1 5", "t.ngc:1:5: expected '='"),      # spaces do not count
-    ("#1 x2", "t.ngc:1:4: expected '='"),
-    ("g1 x#0", "t.ngc:1:5: parameter number 0 out of range"),
-    ("o1 endsub", "t.ngc:1:1: O1 endsub without sub"),
+    ("g1 &5", "t.ngc:1:4: Bad character '&' used"),
+    ("g1 x1 y2 X3", "t.ngc:1:10: Multiple x words on one line"),
+    ("g1 x1.2.3", "t.ngc:1:8: bad number format (trailing characters) "
+                  "parsing '1.2.3'"),
+    ("g1 x", "t.ngc:1:5: No characters found in reading real value"),
+    ("g1 x-", "t.ngc:1:5: bad number format (conversion failed) parsing "
+              "'-'"),
+    ("g1 (open comment", "t.ngc:1:4: Unclosed comment found"),
+    ("g1 (a (b) c)", "t.ngc:1:7: Nested comment found"),
+    ("g1 x[1+[2*3]", "t.ngc:1:5: Unclosed expression"),
+    ("g1 x[1 g 2]", "t.ngc:1:8: Unknown operation name starting with g"),
+    ("g1 x[1 $ 2]", "t.ngc:1:8: Unknown operation"),
+    ("g1 x[2 ** 2000]", "t.ngc:1:8: Calculation resulted in 'infinity'"),
+    ("g0\ng1 x[4/[2-2]]", "t.ngc:2:7: Attempt to divide by zero"),
+    ("g1 x[5 mod 0]", "t.ngc:1:8: Calculation resulted in 'not a number'"),
+    ("g1 x[foo[2]]", "t.ngc:1:6: Unknown word starting with f"),
+    ("g1 x[sqrt[-1]]", "t.ngc:1:6: Negative argument to sqrt"),
+    ("g1 x#<undefined>", "t.ngc:1:5: Named parameter #<undefined> not "
+                         "defined"),
+    ("#<a=1", "t.ngc:1:2: Named parameter not terminated"),
+    ("#1 5", "t.ngc:1:5: Equal sign missing"),      # spaces do not count
+    ("#1 x2", "t.ngc:1:4: Equal sign missing in parameter setting"),
+    ("g1 x#0", "t.ngc:1:5: Parameter number out of range"),
+    ("o1 endsub", "t.ngc:1:1: 1: not in a subroutine definition: "
+                  "'o1 endsub'"),
     ("o<a> sub\no<b> endsub", "t.ngc:2:1: O<b> endsub does not match"),
     ("g0\n  o2 if [1]\ng1", "t.ngc:2:3: O2 if without O2 endif"),
-    ("o2 endif", "t.ngc:1:1: O2 endif without O2 if"),
+    ("o2 endif", "t.ngc:1:1: 1: undefined O-word label: 'o2 endif'"),
     ("o2 if [1]\no2 else\no2 elseif [1]\no2 endif",
      "t.ngc:3:1: O2 elseif after O2 else"),
-    ("o3 while [1]\no4 endwhile", "t.ngc:2:1: O4 endwhile without O4 while"),
-    ("o5 break", "t.ngc:1:1: O5 break outside loop"),
-    ("o<s> sub\ng0", "t.ngc:1:1: O<s> sub without endsub"),
-    ("o9 frob", "t.ngc:1:4: unknown o-word keyword 'frob'"),
-    ("g0 x1\n o<gone> call [1]", "t.ngc:2:2: unknown subroutine O<gone>"),
-    ("g0 o1 call", "t.ngc:1:4: an o-word must start its line"),
+    ("o3 while [1]\no4 endwhile",
+     "t.ngc:2:1: 2: undefined O-word label: 'o4 endwhile'"),
+    ("o3 repeat [2]\no3 endwhile",
+     "t.ngc:2:1: 2: no matching label: 'o3 endwhile' (found 'repeat' in "
+     "line 1)"),
+    ("o5 break", "t.ngc:1:1: 1: undefined O-word label: 'o5 break'"),
+    ("o<s> sub\ng0", "t.ngc:2:1: File ended with no percent sign or "
+                     "program end"),
+    ("o9 frob", "t.ngc:1:4: Unknown control command in o word"),
+    ("g0 x1\n o<gone> call [1]",
+     "t.ngc:2:1: EOF in file:t.ngc seeking o-word: o<gone> from line: 2"),
+    ("g0 o1 call", "t.ngc:1:4: Bad character 'o' used"),
 ])
 def test_error_locations(text: str, expected: str) -> None:
     assert error_of(text).startswith(expected)
@@ -398,15 +410,17 @@ def test_error_in_unreached_line_is_raised_when_reached() -> None:
     program = Program("g0 x1\ng0 x[1\n", "t.ngc")
     blocks = program.blocks()
     assert next(blocks).words == {"x": 1.0}
-    with pytest.raises(GCodeError, match="t.ngc:2:5: unclosed bracket"):
+    with pytest.raises(GCodeError, match="t.ngc:2:5: Unclosed expression"):
         next(blocks)
 
 
 def test_unknown_subroutine_in_file() -> None:
     with pytest.raises(GCodeError) as info:
         list(Program.from_file(str(HERE / "bad_call.ngc")).blocks())
-    assert str(info.value) == (f"{HERE / 'bad_call.ngc'}:2:1: unknown "
-                               "subroutine O<no_such_sub>")
+    path = HERE / "bad_call.ngc"
+    assert str(info.value) == (
+        f"{path}:{len(path.read_text().splitlines())}:1: EOF in "
+        f"file:{path} seeking o-word: o<no_such_sub> from line: 2")
 
 
 def test_error_is_a_value_error_with_fields() -> None:
@@ -431,14 +445,15 @@ def test_endsub_value_and_call_depth_limit() -> None:
     assert params.get(1) == 7.0
     message = error_of("o<r> sub\no<r> call\no<r> endsub\no<r> call\n",
                        max_call_depth=5)
-    assert message.startswith("t.ngc:2:1: subroutine calls nested deeper")
+    assert message.startswith("t.ngc:2:1: Too many subroutine levels")
 
 
 def test_more_than_thirty_arguments_is_an_error() -> None:
     args = " ".join(["[1]"] * 31)
     message = error_of(f"o<s> sub\no<s> endsub\no<s> call {args}")
-    assert message.startswith("t.ngc:3:1: at most 30 subroutine arguments")
+    assert message.startswith("t.ngc:3:1: Too many subroutine parameters")
 
 
 def test_line_number_only_at_start() -> None:
-    assert error_of("g1 n10 x1").startswith("t.ngc:1:4: line number N")
+    assert error_of("g1 n10 x1").startswith("t.ngc:1:4: Bad character 'n' "
+                                           "used")

@@ -1,24 +1,36 @@
 """Our rs274 against the reference's, program by program.
 
 Every ``tests/gcode/programs/GROUP/NAME.ngc`` has the reference's output
-committed next to it (``NAME.out``, ``NAME.status``; regenerate them with
-``programs/regenerate.py``). Our interpreter runs in-process and its
-standard output must equal the golden one byte for byte, and its exit
-status the golden status. The only normalisation: ``-0.0000`` reads as
-``0.0000`` on both sides (a coordinate that is zero up to rounding may
-carry either sign). Standard error is not compared: our messages are our
-own and name file:line:col.
+committed next to it (``NAME.out``, ``NAME.status``, ``NAME.err``;
+regenerate them with ``programs/regenerate.py``). Our interpreter runs
+in-process and its standard output must equal the golden one byte for
+byte, and its exit status the golden status. The only normalisation:
+``-0.0000`` reads as ``0.0000`` on both sides (a coordinate that is zero
+up to rounding may carry either sign).
 
-Programs that still differ are listed in ``programs/xfail.txt`` with the
-difference; they are strict xfails, so a fix shows up as XPASS.
+Its standard error must equal ``NAME.err`` byte for byte too: each error
+is the reference's message, then the line it is about as written. The
+normalisation (:func:`normalise_err`): our ``FILE:LINE:COL: `` before
+each message is removed (the reference does not say where); the path of
+the program reads as ``prog.ngc``, the name the reference ran it under
+(one message names the file); and the ``NAME.err`` loses its first
+character, the newline that ends the reference's ``executing`` banner
+(regenerate.py removes the word, not the newline).
+
+Programs that still differ are listed in ``programs/xfail.txt`` (standard
+output or status) and ``programs/xfail_err.txt`` (standard error) with
+the difference; they are strict xfails, so a fix shows up as XPASS.
 """
 
 from __future__ import annotations
 
 import io
 import os
+import re
 import subprocess
 import sys
+import tempfile
+from functools import cache
 from pathlib import Path
 
 import pytest
@@ -41,10 +53,10 @@ def _programs() -> list[Path]:
                   if not _is_library(p) and p.with_suffix(".out").exists())
 
 
-def _xfails() -> dict[str, str]:
+def _xfails(list_name: str = "xfail.txt") -> dict[str, str]:
     """GROUP/NAME -> why it still differs (programs/xfail.txt)."""
     found: dict[str, str] = {}
-    path = HERE / "xfail.txt"
+    path = HERE / list_name
     if not path.exists():
         return found
     for raw in path.read_text(encoding="utf-8").splitlines():
@@ -60,8 +72,27 @@ def normalise(text: str) -> str:
     return text.replace("-0.0000", "0.0000")
 
 
-def _params() -> list[object]:
-    xfails = _xfails()
+def _place(prog: Path) -> re.Pattern[str]:
+    """Our ``FILE:LINE:COL: `` before a message: the program or a
+    subroutine file of its folder."""
+    return re.compile(rf"^{re.escape(str(prog.parent))}/[^/\n]+\.ngc"
+                      r":\d+:\d+: ", re.M)
+
+
+def normalise_err(ours: str, prog: Path) -> str:
+    """Our standard error as the reference would print it: without the
+    ``FILE:LINE:COL: `` of each message, the program named prog.ngc."""
+    return _place(prog).sub("", ours).replace(str(prog), "prog.ngc")
+
+
+def golden_err(prog: Path) -> str:
+    """``NAME.err`` without the newline of the reference's banner."""
+    text = prog.with_suffix(".err").read_text(encoding="utf-8")
+    return text[1:] if text.startswith("\n") else text
+
+
+def _params(list_name: str = "xfail.txt") -> list[object]:
+    xfails = _xfails(list_name)
     out = []
     for prog in _programs():
         name = f"{prog.parent.name}/{prog.stem}"
@@ -75,6 +106,19 @@ def _params() -> list[object]:
 
 def ours(prog: Path, tmp_path: Path) -> tuple[str, int]:
     """Our rs274 on ``prog``, in-process: (stdout, exit status)."""
+    out, status, _ = ours_all(prog, tmp_path)
+    return out, status
+
+
+@cache
+def ours_cached(prog: Path) -> tuple[str, int, str]:
+    """:func:`ours_all` once per program (two tests compare its output)."""
+    with tempfile.TemporaryDirectory(prefix="rs274-golden-") as tmp:
+        return ours_all(prog, Path(tmp))
+
+
+def ours_all(prog: Path, tmp_path: Path) -> tuple[str, int, str]:
+    """Our rs274 on ``prog``, in-process: (stdout, exit status, stderr)."""
     out, err = io.StringIO(), io.StringIO()
     tbl = prog.with_suffix(".tbl")
     var = prog.with_suffix(".var")
@@ -92,15 +136,34 @@ def ours(prog: Path, tmp_path: Path) -> tuple[str, int]:
                  ini=IniFile(str(ini)) if ini.exists() else None,
                  block_delete="-b" in options,
                  keep_going="-n 0" in " ".join(options))
-    return out.getvalue(), status
+    return out.getvalue(), status, err.getvalue()
 
 
 @pytest.mark.parametrize("prog", _params())
-def test_matches_reference(prog: Path, tmp_path: Path) -> None:
-    got, status = ours(prog, tmp_path)
+def test_matches_reference(prog: Path) -> None:
+    got, status, _ = ours_cached(prog)
     want = prog.with_suffix(".out").read_text(encoding="utf-8")
     want_status = int(prog.with_suffix(".status").read_text())
     assert (normalise(got), status) == (normalise(want), want_status)
+
+
+@pytest.mark.parametrize("prog", _params("xfail_err.txt"))
+def test_errors_match_reference(prog: Path) -> None:
+    """The reference's messages, each after our file:line:col."""
+    _, _, err = ours_cached(prog)
+    want = golden_err(prog)
+    assert normalise_err(err, prog) == want
+    # every message says where: one FILE:LINE:COL per message
+    assert len(_place(prog).findall(err)) == len(want.splitlines()) // 2
+
+
+def test_normalise_err() -> None:
+    prog = HERE / "errors" / "div_zero.ngc"
+    ours = (f"{prog}:1:9: Attempt to divide by zero\n#1 = [1 / 0]\n"
+            f"{prog}:3:1: EOF in file:{prog} seeking o-word\nM2\n")
+    assert normalise_err(ours, prog) == (
+        "Attempt to divide by zero\n#1 = [1 / 0]\n"
+        "EOF in file:prog.ngc seeking o-word\nM2\n")
 
 
 def test_enough_programs() -> None:
@@ -111,6 +174,7 @@ def test_enough_programs() -> None:
 def test_xfail_list_names_programs() -> None:
     names = {f"{p.parent.name}/{p.stem}" for p in _programs()}
     assert set(_xfails()) <= names
+    assert set(_xfails("xfail_err.txt")) <= names
 
 
 def test_console_script(tmp_path: Path) -> None:
@@ -194,4 +258,9 @@ def test_any_program_ends_with_a_status_not_a_crash(lines: list) -> None:
     assert status in (0, 1)
     assert out.getvalue().endswith("ON_RESET()\n")
     if status:
-        assert err.getvalue().startswith("fuzz.ngc:")
+        # the message after its place, then the line as written, as the
+        # reference prints it
+        first, second = err.getvalue().split("\n")[:2]
+        place = re.match(r"fuzz\.ngc:(\d+):(\d+): \S", first)
+        assert place, first
+        assert second == (lines + ["M2"])[int(place.group(1)) - 1]

@@ -7,8 +7,9 @@
 Each program is a few random lines of G/M codes and words (a feed rate
 first, M2 last). The reference's ``rs274 -g`` runs it in a fresh folder
 (one at a time, at most 20 s each) and our rs274 runs it in-process; a
-program whose standard output (``-0.0000`` read as ``0.0000``) or exit
-status differs is printed with the reference's message and saved in
+program whose standard output (``-0.0000`` read as ``0.0000``), exit
+status or standard error (without our ``FILE:LINE:COL:`` before each
+message) differs is printed with the reference's message and saved in
 ``--keep`` (default rs274-fuzz in the temp folder) as ``misN.ngc``: copy the useful
 ones to ``errors/`` and run regenerate.py on them. Run by hand, never by
 the test suite (it needs the reference).
@@ -20,6 +21,7 @@ import argparse
 import io
 import os
 import random
+import re
 import subprocess
 import sys
 import tempfile
@@ -75,18 +77,22 @@ def main() -> int:
             except subprocess.TimeoutExpired:
                 print(f"{n}: the reference timed out")
                 continue
-        out = io.StringIO()
-        status = run(text, "p.ngc", out.write, io.StringIO().write)
+        out, err = io.StringIO(), io.StringIO()
+        status = run(text, "p.ngc", out.write, err.write)
         ours = out.getvalue().replace("-0.0000", "0.0000")
         theirs = ref.stdout.replace("-0.0000", "0.0000")
-        if (ours, status) != (theirs, ref.returncode):
+        ours_err = re.sub(r"^p\.ngc:\d+:\d+: ", "", err.getvalue(),
+                          flags=re.M)
+        theirs_err = ref.stderr.removeprefix("executing\n")
+        if (ours, status, ours_err) != (theirs, ref.returncode, theirs_err):
             differ += 1
             with open(os.path.join(a.keep, f"mis{n}.ngc"), "w",
                       encoding="utf-8") as f:
                 f.write(text)
             message = ref.stderr.replace("executing", "").strip()
             print(f"{n}: differs (ours {status}, reference "
-                  f"{ref.returncode}) {message.splitlines()[:1]}")
+                  f"{ref.returncode}) {message.splitlines()[:1]} "
+                  f"{ours_err.splitlines()[:1]}")
     print(f"{a.count - differ} of {a.count} programs match")
     return 0
 

@@ -20,9 +20,9 @@ program:
 * ``NAME.out``: the standard output (the golden data compared byte for
   byte by tests/gcode/test_rs274_golden.py);
 * ``NAME.status``: the exit status;
-* ``NAME.err``: the standard error without the reference's
-  ``executing`` banner (kept for reading: its messages differ from ours,
-  which add file:line:col).
+* ``NAME.err``: the standard error without the word of the reference's
+  ``executing`` banner (its newline stays); compared with ours, which
+  adds file:line:col before each message.
 
 Runs are sequential. The reference is an oracle only: this script is run
 by hand, never by the test suite.
