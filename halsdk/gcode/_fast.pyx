@@ -71,10 +71,46 @@ cdef inline Py_ssize_t _number(const char *s, Py_ssize_t pos,
     return pos
 
 
+#: the powers of ten that a double holds exactly
+cdef double _POW10[23]
+for _i in range(23):
+    _POW10[_i] = 10.0 ** _i
+
+
 cdef double _value(const char *s, Py_ssize_t start,
                    Py_ssize_t end) except? -1.0:
+    """The value of the number ``s[start:end]`` that :func:`_number`
+    found: what ``float()`` gives for it, the nearest double."""
     cdef char buf[72]
-    cdef Py_ssize_t size = end - start
+    cdef Py_ssize_t size = end - start, i = start
+    cdef unsigned long long mantissa = 0
+    cdef int significant = 0, fraction = 0
+    cdef bint negative = False, point = False
+    cdef char c
+    cdef double value
+    # up to 15 significant digits and 22 decimals: the digits as an
+    # integer and the power of ten are both exact doubles, so their
+    # quotient, one rounding, is the nearest double to the number (the
+    # exact case of decimal conversion); else Python's conversion
+    if s[i] == 43 or s[i] == 45:
+        negative = s[i] == 45
+        i += 1
+    while i < end:
+        c = s[i]
+        i += 1
+        if c == 46:
+            point = True
+            continue
+        if mantissa or c != 48:
+            significant += 1
+        mantissa = mantissa * 10 + <unsigned long long>(c - 48)
+        if point:
+            fraction += 1
+    if significant <= 15 and fraction <= 22:
+        value = <double>mantissa
+        if fraction:
+            value = value / _POW10[fraction]
+        return -value if negative else value
     memcpy(buf, s + start, size)
     buf[size] = 0
     return PyOS_string_to_double(buf, NULL, None)

@@ -308,3 +308,23 @@ def test_the_loop_takes_plain_moves_and_hands_out_the_rest() -> None:
     # without the interpreter every line with words is handed out
     program = Program("G1 X1\nG1 X2\n", "p.ngc", Parameters())
     assert [b.text for b in program.blocks()] == ["G1 X1", "G1 X2"]
+
+
+digits = st.text("0123456789", max_size=25)
+
+
+@settings(max_examples=500, deadline=None)
+@given(st.sampled_from(["", "+", "-"]), digits, st.booleans(), digits)
+def test_numbers_are_read_as_float_reads_them(sign: str, whole: str,
+                                              point: bool,
+                                              decimals: str) -> None:
+    # the compiled reader converts short numbers itself (an exact
+    # division), longer ones with Python's conversion: both are float()'s
+    text = sign + whole + ("." + decimals if point else "")
+    if not (whole or point and decimals):
+        return                                  # no digits: no number
+    read = _fast.simple_words(f"X{text}")
+    assert read is not None
+    value = read[1][0][1]
+    assert value == float(text)
+    assert str(value) == str(float(text))       # -0.0 too
