@@ -22,6 +22,7 @@ from .errors import GCodeError
 from .lexer import parse_line
 
 cdef extern from "Python.h":
+    bint PyUnicode_IS_ASCII(object o)
     double PyOS_string_to_double(const char *s, char **endptr,
                                  object overflow_exception) except? -1.0
 
@@ -70,10 +71,46 @@ cdef inline Py_ssize_t _number(const char *s, Py_ssize_t pos,
     return pos
 
 
+#: the powers of ten that a double holds exactly
+cdef double _POW10[23]
+for _i in range(23):
+    _POW10[_i] = 10.0 ** _i
+
+
 cdef double _value(const char *s, Py_ssize_t start,
                    Py_ssize_t end) except? -1.0:
+    """The value of the number ``s[start:end]`` that :func:`_number`
+    found: what ``float()`` gives for it, the nearest double."""
     cdef char buf[72]
-    cdef Py_ssize_t size = end - start
+    cdef Py_ssize_t size = end - start, i = start
+    cdef unsigned long long mantissa = 0
+    cdef int significant = 0, fraction = 0
+    cdef bint negative = False, point = False
+    cdef char c
+    cdef double value
+    # up to 15 significant digits and 22 decimals: the digits as an
+    # integer and the power of ten are both exact doubles, so their
+    # quotient, one rounding, is the nearest double to the number (the
+    # exact case of decimal conversion); else Python's conversion
+    if s[i] == 43 or s[i] == 45:
+        negative = s[i] == 45
+        i += 1
+    while i < end:
+        c = s[i]
+        i += 1
+        if c == 46:
+            point = True
+            continue
+        if mantissa or c != 48:
+            significant += 1
+        mantissa = mantissa * 10 + <unsigned long long>(c - 48)
+        if point:
+            fraction += 1
+    if significant <= 15 and fraction <= 22:
+        value = <double>mantissa
+        if fraction:
+            value = value / _POW10[fraction]
+        return -value if negative else value
     memcpy(buf, s + start, size)
     buf[size] = 0
     return PyOS_string_to_double(buf, NULL, None)
@@ -86,18 +123,38 @@ def simple_words(str text):
     return _simple_words(text)
 
 
-cdef object _simple_words(str text):
-    cdef Py_ssize_t n
-    cdef const char *s
+cdef enum:
+    # most words a line read by _scan may have (more: the full lexer)
+    MAX_WORDS = 48
+
+
+cdef struct Words:
+    # a line of plain numbered words, read by _scan
+    int count                   # words, in source order:
+    char letter[MAX_WORDS]      # 0..25 (a..z)
+    double value[MAX_WORDS]
+    Py_ssize_t column[MAX_WORDS]  # 1-based
+    bint has_n                  # an N word, with its number
+    double n
+    unsigned int seen           # a bit per letter, G and M excluded
+    double by_letter[26]        # the value of each letter of ``seen``
+    int g, m                    # how many G and M words
+    double g0                   # the first G number
+
+
+cdef bint _scan(const char *s, Py_ssize_t n, Words *w) except -1:
+    """Read the plain numbered words of ``s[:n]`` into ``w``: False when
+    the line needs the full lexer (anything else, or a non-ASCII byte)."""
     cdef Py_ssize_t pos = 0, end, column
     cdef char c
-    cdef unsigned int seen = 0, bit
+    cdef unsigned int bit
     cdef int letter
-    cdef object line_number = None
-    cdef list words = []
-    if not text.isascii():
-        return None
-    s = PyUnicode_AsUTF8AndSize(text, &n)
+    cdef double value
+    w.count = 0
+    w.has_n = False
+    w.seen = 0
+    w.g = 0
+    w.m = 0
     while pos < n and _space(s[pos]):
         pos += 1
     if pos < n and (s[pos] == 110 or s[pos] == 78):       # n N
@@ -105,11 +162,12 @@ cdef object _simple_words(str text):
         while pos < n and _space(s[pos]):
             pos += 1
         if pos >= n or not _digit(s[pos]):
-            return None
+            return False
         end = _number(s, pos, n, False)
         if end - pos > 64:
-            return None
-        line_number = _value(s, pos, end)
+            return False
+        w.has_n = True
+        w.n = _value(s, pos, end)
         pos = end
         while pos < n and _space(s[pos]):
             pos += 1
@@ -118,25 +176,57 @@ cdef object _simple_words(str text):
         if 65 <= c <= 90:
             c = c + 32
         if not (97 <= c <= 122) or c == 110 or c == 111:   # not n, o
-            return None
+            return False
         letter = c - 97
         column = pos + 1
         pos += 1
         while pos < n and _space(s[pos]):
             pos += 1
         end = _number(s, pos, n, True)
-        if end < 0 or end - pos > 64:
-            return None
-        if c != 103 and c != 109:                          # not g, m
+        if end < 0 or end - pos > 64 or w.count == MAX_WORDS:
+            return False
+        value = _value(s, pos, end)
+        if c == 103:                                       # g
+            if w.g == 0:
+                w.g0 = value
+            w.g += 1
+        elif c == 109:                                     # m
+            w.m += 1
+        else:
             bit = 1u << letter
-            if seen & bit:
-                return None         # two X words: parse_line says where
-            seen |= bit
-        words.append((_LETTERS[letter], _value(s, pos, end), column))
+            if w.seen & bit:
+                return False        # two X words: parse_line says where
+            w.seen |= bit
+            w.by_letter[letter] = value
+        w.letter[w.count] = letter
+        w.value[w.count] = value
+        w.column[w.count] = column
+        w.count += 1
         pos = end
         while pos < n and _space(s[pos]):
             pos += 1
-    return line_number, words
+    return True
+
+
+cdef object _words_of(Words *w):
+    """What :func:`simple_words` gives for the words of ``w``."""
+    cdef list words = []
+    cdef int i
+    for i in range(w.count):
+        words.append((_LETTERS[<int>w.letter[i]], w.value[i], w.column[i]))
+    return (w.n if w.has_n else None), words
+
+
+cdef object _simple_words(str text):
+    cdef Py_ssize_t n
+    cdef const char *s
+    cdef Words w
+    if not PyUnicode_IS_ASCII(text):
+        return None
+    s = PyUnicode_AsUTF8AndSize(text, &n)
+    if not _scan(s, n, &w):
+        return None
+    return _words_of(&w)
 
 
 def simple_block(str file, int number, str text, object line_number,
@@ -197,10 +287,17 @@ EMPTY = ("empty line",)
 cdef object _FileLines = None
 
 
-def set_file_lines(cls):
-    """Tell :func:`read_line` the class of streamed files."""
-    global _FileLines
+#: the class of programs held in memory (program._TextLines, set by it)
+cdef object _TextLines = None
+
+
+def set_file_lines(cls, text_cls=None):
+    """Tell :func:`read_line` the class of streamed files (and
+    :func:`run_plain` the class of programs in memory)."""
+    global _FileLines, _TextLines
     _FileLines = cls
+    if text_cls is not None:
+        _TextLines = text_cls
 
 
 def read_line(object unit, Py_ssize_t index):
@@ -214,9 +311,7 @@ def read_line(object unit, Py_ssize_t index):
     """
     cdef dict kept = unit._kept
     cdef object entry = kept.get(index) if kept else None
-    cdef object text, simple, source, raw
-    cdef list starts
-    cdef Py_ssize_t at
+    cdef object text, source, raw
     if entry is None:
         entry = unit.owords.get(index)
         if entry is not None:
@@ -232,19 +327,35 @@ def read_line(object unit, Py_ssize_t index):
             text = source.line(index)
             if text is None:
                 return None
-        simple = _simple_words(text)
-        if simple is not None:
-            entry = (text, simple[0], simple[1])
-        else:
-            try:
-                entry = parse_line(text, unit.file, index + 1)
-            except GCodeError as exc:
-                entry = exc
-        starts = unit._keep_starts
-        if starts:
-            at = bisect.bisect_right(starts, index) - 1
-            if at >= 0 and index <= unit._keep_ends[at]:
-                kept[index] = entry
+        entry = _entry(unit, index, text)
+    return _ready(unit, index, entry)
+
+
+cdef object _entry(object unit, Py_ssize_t index, str text):
+    """The entry of line ``index`` read from ``text``: the fast path's
+    (text, N number, words), a ``Line``, or the ``GCodeError`` of a line
+    that cannot be read; kept when the line is in a keep range."""
+    cdef object entry, simple
+    cdef list starts
+    cdef Py_ssize_t at
+    simple = _simple_words(text)
+    if simple is not None:
+        entry = (text, simple[0], simple[1])
+    else:
+        try:
+            entry = parse_line(text, unit.file, index + 1)
+        except GCodeError as exc:
+            entry = exc
+    starts = unit._keep_starts
+    if starts:
+        at = bisect.bisect_right(starts, index) - 1
+        if at >= 0 and index <= unit._keep_ends[at]:
+            unit._kept[index] = entry
+    return entry
+
+
+cdef inline object _ready(object unit, Py_ssize_t index, object entry):
+    """What read_line gives for ``entry``."""
     if type(entry) is tuple:
         if not entry[2]:
             return EMPTY
@@ -514,3 +625,314 @@ cdef bint _arc(object interp, object block, dict words, object modal,
                             feed, line))
     interp.pos = end
     return True
+
+
+# -- the read-execute loop of plain moves ------------------------------------
+
+from cpython.object cimport PyObject_GenericSetAttr
+from cpython.bytes cimport PyBytes_AS_STRING, PyBytes_GET_SIZE
+
+from .cutter_radius import CutterComp
+
+cdef object _CutterComp = CutterComp
+cdef str _DICT = "__dict__"
+#: the letters a plain move may have: axes, centre words, R, P (a bit per
+#: letter); F is for the general path (the feed's bookkeeping)
+cdef unsigned int _AXIS_BITS = 0
+cdef unsigned int _ARC_BITS = 0
+for _c in "xyzabcuvw":
+    _AXIS_BITS |= 1u << (ord(_c) - 97)
+for _c in "ijkrp":
+    _ARC_BITS |= 1u << (ord(_c) - 97)
+cdef int _I = ord("i") - 97
+cdef int _R = ord("r") - 97
+cdef int _P = ord("p") - 97
+#: the motion codes as the modal state holds them (G0 .. G3)
+cdef tuple _MOTIONS = (0, 10, 20, 30)
+#: _AXES as letter numbers
+cdef int _AXIS_LETTER[9]
+for _i, _c in enumerate(_AXES):
+    _AXIS_LETTER[_i] = ord(_c) - 97
+
+
+cdef struct Machine:
+    # what run_plain reads of the interpreter once per call (plain moves
+    # change none of it but the position and the motion mode)
+    double g5x[9]
+    double g92[9]
+    double tlo[9]
+    double k                # program units -> machine units
+    double tol              # Interpreter._arc's radius tolerance
+    double feed
+    bint incremental        # G91
+    bint relative_centres   # G91.1
+    int a1, a2              # the plane's axes
+    int w1, w2, other       # its centre words (letter numbers)
+
+
+cdef inline bint _in_ranges(list starts, list ends, Py_ssize_t index):
+    """True if ``index`` is in one of the sorted (start, end) ranges."""
+    cdef Py_ssize_t at = bisect.bisect_right(starts, index) - 1
+    return at >= 0 and index <= <Py_ssize_t>ends[at]
+
+
+cdef inline object _command(object cls, dict fields):
+    """An instance of the frozen dataclass ``cls`` holding ``fields``
+    (what its __init__ stores; see _plain)."""
+    command = _new(cls)
+    PyObject_GenericSetAttr(command, _DICT, fields)
+    return command
+
+
+cdef bint _ready_state(object interp, object modal, Machine *m) except -1:
+    """Read the state into ``m``; False when it is one that the short
+    path does not know (see Interpreter._fast_ready and fast_move): the
+    reference's calls, G7, a rotated coordinate system, the M73
+    restore, inverse time, cutter compensation."""
+    cdef dict numbered
+    cdef list g92, tlo
+    cdef int base, i
+    cdef object comp = interp.comp
+    cdef object plane
+    if (interp.ref or interp.diameter_mode or interp._autosaved
+            or modal.feed_mode == 930
+            or type(comp) is not _CutterComp or comp.active
+            or comp._pending is not None):
+        return False
+    if not (_DIRECT_FEED and _DIRECT_TRAVERSE and _DIRECT_ARC):
+        return False
+    base = 20 * (_COORD_CODES.index(modal.coord_system) + 1)
+    if interp.params.get(5210 + base):
+        return False                        # G10 L2 R: rotated
+    numbered = interp.params._numbered
+    g92 = interp.g92
+    tlo = interp.tlo
+    for i in range(9):
+        m.g5x[i] = numbered.get(5201 + base + i, 0.0)
+        m.g92[i] = g92[i]
+        m.tlo[i] = tlo[i]
+    m.k = _factor(interp, modal)
+    m.tol = 0.005 if interp.machine_metric else 0.0005
+    m.feed = interp.feed
+    m.incremental = modal.distance == 910
+    m.relative_centres = modal.arc_distance != 901
+    plane = modal.plane
+    if plane not in _PLANES:
+        return False
+    m.a1, m.a2, _, centre = _PLANES[plane]
+    m.w1 = ord(centre[0]) - 97
+    m.w2 = ord(centre[1]) - 97
+    m.other = ord(_OTHER_CENTRE[plane]) - 97
+    return True
+
+
+def run_plain(object unit, Py_ssize_t index, object interp,
+              bint main_flow):
+    """Execute the plain moves of ``unit`` from line ``index`` on with
+    ``interp`` (what ``Interpreter.execute`` does with their blocks,
+    without making the blocks) until a line that they cannot take.
+
+    Gives ``(index, entry, ran)``: that line's index, what
+    :func:`read_line` gives for it, and whether any move ran.  A plain
+    move is a line :func:`simple_words` reads holding G0-G3 (or
+    nothing: the modal motion), axis words, and the centre words and P
+    of a centre-format arc with relative centres, in a state that
+    :func:`fast_move` takes; with ``main_flow``, not a line of a
+    subroutine definition.  Everything else is the caller's, and so is
+    every error: a move that would fail is not run here but handed back
+    as its Block.  The property tests of tests/gcode/
+    test_gcode_fastpath.py hold it to the general path.
+    """
+    cdef dict kept = unit._kept
+    cdef dict owords = unit.owords
+    cdef object source = unit.source
+    cdef object structure = unit.structure
+    cdef list sub_starts = structure.sub_starts
+    cdef list sub_ends = structure.sub_ends
+    cdef list keep_starts = unit._keep_starts
+    cdef list keep_ends = unit._keep_ends
+    cdef list lines = None
+    cdef Py_ssize_t count = source.count
+    cdef bint is_file = source.__class__ is _FileLines
+    cdef bint ran = False, has_axes
+    cdef int ready = 0              # 1: the state is in ``m``; -1: no
+    cdef Words w
+    cdef Machine m
+    cdef const char *s
+    cdef Py_ssize_t n
+    cdef object raw, text, entry, modal = None, emit = None, line
+    cdef object motion_now, explicit, plane_code = None
+    cdef list pos, end
+    cdef double prog[9]
+    cdef double e[9]
+    cdef double value, c1 = 0.0, c2 = 0.0, r1, r2, p
+    cdef int i, motion, turn = 0
+    cdef unsigned int letters
+    cdef tuple end_tuple
+    if not (main_flow and sub_starts):
+        sub_starts = None
+    if not keep_starts:
+        keep_starts = None
+    if source.__class__ is _TextLines:
+        lines = source.lines
+    while True:
+        raw = None
+        text = None
+        entry = kept.get(index) if kept else None
+        if entry is None:
+            entry = owords.get(index)
+            if entry is not None:
+                return index, entry, ran
+            if index >= count:
+                return index, None, ran
+            if lines is not None:
+                text = lines[index]
+            elif is_file and source._file is not None \
+                    and index == source._next:
+                raw = source._file.readline()
+                source._next = index + 1
+            else:
+                text = source.line(index)
+            if keep_starts is not None and \
+                    _in_ranges(keep_starts, keep_ends, index):
+                if raw is not None:
+                    text = raw.decode("utf-8").rstrip("\r\n")
+                    raw = None
+                entry = _entry(unit, index, text)       # kept
+                if type(entry) is not tuple:
+                    return index, entry, ran
+                text = entry[0]
+        elif type(entry) is not tuple:
+            return index, entry, ran
+        else:
+            text = entry[0]
+        # the words, read from the bytes of the file or from the text
+        if raw is not None:
+            s = PyBytes_AS_STRING(raw)
+            n = PyBytes_GET_SIZE(raw)
+            while n > 0 and (s[n - 1] == 10 or s[n - 1] == 13):
+                n -= 1
+            if not _scan(s, n, &w):
+                text = raw.decode("utf-8").rstrip("\r\n")
+                return index, _ready(unit, index, _entry(unit, index, text)), \
+                    ran
+        elif not PyUnicode_IS_ASCII(text) or not _scan(
+                PyUnicode_AsUTF8AndSize(text, &n), n, &w):
+            if entry is None:
+                entry = _entry(unit, index, text)
+            return index, _ready(unit, index, entry), ran
+        if sub_starts is not None and \
+                _in_ranges(sub_starts, sub_ends, index):
+            break                   # the caller skips the definition
+        if w.count == 0:
+            index += 1              # EMPTY
+            continue
+        # what fast_move refuses without looking at the state: M codes,
+        # G codes other than one G0-G3, words other than axes and arcs'
+        letters = w.seen
+        if (w.m or w.g > 1 or letters & ~(_AXIS_BITS | _ARC_BITS)
+                or (w.g == 1 and not (w.g0 == 0.0 or w.g0 == 1.0
+                                      or w.g0 == 2.0 or w.g0 == 3.0))):
+            break
+        if ready == 0:
+            modal = interp.modal
+            ready = 1 if _ready_state(interp, modal, &m) else -1
+            emit = interp.canon.emit
+            plane_code = modal.plane // 10
+            # no Block is made: the interpreter names none as the current
+            interp.line_block = None
+        if ready < 0:
+            break
+        has_axes = (letters & _AXIS_BITS) != 0
+        if w.g == 1:
+            motion = <int>w.g0 * 10
+            explicit = _MOTIONS[<int>w.g0]
+        else:
+            explicit = None
+            motion_now = modal.motion
+            if motion_now is None:
+                break
+            motion = motion_now
+            if motion != 0 and motion != 10 and motion != 20 \
+                    and motion != 30:
+                break
+        if letters & _ARC_BITS and not (
+                (motion == 20 or motion == 30)
+                and (has_axes or explicit is not None)):
+            break
+        if motion != 0 and (has_axes or motion != 10) and m.feed <= 0:
+            break                   # the general path's error
+        if motion == 20 or motion == 30:
+            # fast_move's _arc: relative centres, no R; the rest
+            # (errors included) is the general path's
+            if not m.relative_centres or letters & (1u << _R):
+                break
+            if not (letters & (1u << m.w1) or letters & (1u << m.w2)) \
+                    or letters & (1u << m.other):
+                break
+        line = index + 1
+        # Interpreter._target (not G53, no rotation, no G7)
+        if has_axes or motion == 20 or motion == 30:
+            pos = interp.pos
+            for i in range(9):
+                prog[i] = (<double>pos[i] - m.g5x[i] - m.g92[i]
+                           - m.tlo[i])
+            for i in range(9):
+                if letters & (1u << _AXIS_LETTER[i]):
+                    value = w.by_letter[_AXIS_LETTER[i]] * (
+                        1.0 if 3 <= i <= 5 else m.k)
+                    prog[i] = prog[i] + value if m.incremental else value
+            for i in range(9):
+                e[i] = prog[i] + m.g5x[i] + m.g92[i] + m.tlo[i]
+        if motion == 20 or motion == 30:
+            # _arc's checks first: a failing arc is the general path's
+            c1 = <double>pos[m.a1] + (
+                (w.by_letter[m.w1] if letters & (1u << m.w1) else 0.0)
+                * m.k)
+            c2 = <double>pos[m.a2] + (
+                (w.by_letter[m.w2] if letters & (1u << m.w2) else 0.0)
+                * m.k)
+            r1 = _hypot(<double>pos[m.a1] - c1, <double>pos[m.a2] - c2)
+            r2 = _hypot(e[m.a1] - c1, e[m.a2] - c2)
+            if r1 < m.tol or r2 < m.tol:
+                break               # a zero-radius arc: the general error
+            if abs(r1 - r2) > m.tol and abs(r1 - r2) > 0.001 * r1:
+                break
+            turn = 1
+            if letters & (1u << _P):
+                p = w.by_letter[_P]
+                if p < 1 or abs(p - _round(p)) > 1e-6:
+                    break
+                turn = int(_round(p))
+            if motion == 20:
+                turn = -turn
+        # run it (fast_move's order)
+        interp.line = line
+        if explicit is not None:
+            modal.motion = explicit
+        if motion == 0 or motion == 10:
+            if has_axes:
+                end = [e[i] for i in range(9)]
+                end_tuple = tuple(end)
+                if motion == 10:
+                    emit(_command(_StraightFeed, {
+                        "end": end_tuple, "feed": m.feed, "line": line}))
+                else:
+                    emit(_command(_StraightTraverse, {
+                        "end": end_tuple, "line": line}))
+                interp.pos = end
+        else:
+            end = [e[i] for i in range(9)]
+            emit(_command(_ArcFeed, {
+                "end": tuple(end), "center": (c1, c2),
+                "plane": plane_code, "turn": turn, "feed": m.feed,
+                "line": line}))
+            interp.pos = end
+        ran = True
+        index += 1
+    # line ``index`` is the caller's
+    if entry is None:
+        if text is None:
+            text = raw.decode("utf-8").rstrip("\r\n")
+        entry = _entry(unit, index, text)
+    return index, _ready(unit, index, entry), ran

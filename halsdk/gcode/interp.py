@@ -40,6 +40,7 @@ from .cutter_radius import CutterComp, CutterRadiusError
 from .messages import PLANE_NAME, arc_radius_differs, unused_word, zero_radius_arc
 from .modal import AXIS_USERS_GROUP0, ModalState, group_codes
 from .nurbs import polyline as nurbs_polyline
+from .program import Program
 
 _DEBUG_PARAM = re.compile(r"#\s*<([^>]*)>|#\s*(\d+)")
 
@@ -338,7 +339,11 @@ class Interpreter:
     def run(self, program: Any) -> None:
         """Execute every block of ``program`` until it ends."""
         self.program = program
-        for block in program.blocks():
+        # plain moves run as the program reads them (compiled), unless a
+        # subclass executes blocks its own way
+        fast = type(self).execute is Interpreter.execute and \
+            isinstance(program, Program)
+        for block in program.blocks(self) if fast else program.blocks():
             self.execute(block)
             if self.ended:
                 break

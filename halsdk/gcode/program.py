@@ -8,9 +8,9 @@ import re
 import time
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
-from typing import BinaryIO, Optional, Union
+from typing import Any, BinaryIO, Optional, Union
 
-from ._fast import EMPTY, read_line, set_file_lines
+from ._fast import EMPTY, read_line, run_plain, set_file_lines
 from .block import Block, code_key
 from .errors import GCodeError
 from .expr import Expr, ParamRef, Where
@@ -168,7 +168,7 @@ class _FileLines:
             self._next = 0
 
 
-set_file_lines(_FileLines)
+set_file_lines(_FileLines, _TextLines)
 
 
 def _read_file(path: str) -> tuple[Union[_TextLines, _FileLines],
@@ -613,14 +613,20 @@ class Program:
         the main program), as the reference's status ``call_level``."""
         return len(self._frames)
 
-    def blocks(self) -> Iterator[Block]:
+    def blocks(self, interp: Any = None) -> Iterator[Block]:
         """The blocks in execution order (see the class docstring); ends at
-        M2/M30, the closing '%' or the end of the file."""
+        M2/M30, the closing '%' or the end of the file.
+
+        With ``interp`` (an :class:`~halsdk.gcode.interp.Interpreter`;
+        its ``run`` does this), the plain moves that its short path takes
+        are executed by it as they are read, by compiled code, and not
+        handed out (``_fast.run_plain``): the consumer must execute
+        every block it gets with that interpreter, and nothing else."""
         self.params.reset_scopes()
         self.iterations = 0
         self._idle_since = self.clock()
         try:
-            yield from self._run()
+            yield from self._run(interp)
         finally:
             self.params.reset_scopes()
             self._main.close()
@@ -639,7 +645,7 @@ class Program:
         """Use the subroutine files ``other`` has read (and read more)."""
         self._files = other._files
 
-    def _run(self) -> Iterator[Block]:
+    def _run(self, interp: Any = None) -> Iterator[Block]:
         unit = self._main
         index = 0
         frames: list[_Frame] = []
@@ -649,7 +655,15 @@ class Program:
         clock = self.clock
         structure = unit.structure
         while True:
-            entry = read_line(unit, index)
+            if interp is None:
+                entry = read_line(unit, index)
+            else:
+                # plain moves run at once; the line it stops at is ours
+                index, entry, ran = run_plain(unit, index, interp,
+                                              not frames)
+                if ran:
+                    seen_code = True
+                    self._idle_since = clock()
             if entry is None:
                 if frames:  # pragma: no cover - the scan rules it out
                     raise GCodeError(

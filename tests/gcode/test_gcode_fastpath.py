@@ -5,11 +5,19 @@ with axis, F and arc words) to the compiled ``fast_move``; every other
 block, and any block through ``Interpreter._execute``, goes the general
 way.  For random machine states and moves, both must emit the same
 commands, end in the same state and refuse the same blocks.
+
+``Interpreter.run`` goes further: the program executes runs of plain
+moves itself, in compiled code, without making their blocks
+(``_fast.run_plain``).  Random programs, held in memory or streamed from
+a file, with loops and subroutines, must run as they do block by block,
+for the recording canon, the reference's calls and the ``rs274`` text.
 """
 
 from __future__ import annotations
 
 import copy
+import os
+import tempfile
 
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -17,16 +25,17 @@ from hypothesis import strategies as st
 from halsdk.gcode import GCodeError, Parameters, Program, _fast
 from halsdk.gcode import interp as interp_module
 from halsdk.gcode.canon import RecordingCanon
+from halsdk.gcode.canon_text import TextCanon
 from halsdk.gcode.interp import Interpreter
 
-SETUP = st.lists(st.sampled_from([
+SETUP_LINES = [
     "G20", "G21", "G90", "G91", "G93", "G94", "G17", "G18", "G19",
     "G0", "G1", "G2", "G3", "G80", "G55", "G54", "G59.3", "F0", "F250",
     "G10 L2 P2 X3 Y-4 Z1.5 A10", "G10 L2 P1 X-1 Y2 W7", "G92 X1 Y1",
     "G92.1", "G43.1 Z2.5", "G49", "G0 X1 Y2 Z3", "G1 X-2 Y5 F100",
     "G91.1", "G90.1", "G7", "G8", "G10 L2 P0 R30", "G10 L2 P1 X1 R-15",
-    "G10 L2 P2 R0", "G95", "M70", "M72", "(a comment)", "G5 X1 Y1 P1 Q1"]),
-    max_size=8)
+    "G10 L2 P2 R0", "G95", "M70", "M72", "(a comment)", "G5 X1 Y1 P1 Q1"]
+SETUP = st.lists(st.sampled_from(SETUP_LINES), max_size=8)
 
 value = st.sampled_from(["0", "1", "-2.5", "0.1234", "10", "-0.5", "3"])
 MOVE = st.tuples(
@@ -133,3 +142,189 @@ def test_arcs_take_the_general_path_s_way(setup: list[str], code: str,
 
 def test_fast_path_planes_are_the_interpreter_s() -> None:
     assert _fast.PLANES == interp_module.PLANES
+
+
+# -- the read-execute loop (Interpreter.run: _fast.run_plain) ---------------
+#
+# Interpreter.run lets the program execute runs of plain moves itself, in
+# compiled code, without making their blocks.  Whole programs must run as
+# they do block by block through the general path (Interpreter._execute
+# only), and as block by block through Interpreter.execute: the same
+# commands, the same end state, the same error.
+
+
+class General(Interpreter):
+    """Every block through the general path (no short path at all)."""
+
+    def execute(self, block) -> None:
+        self._execute(block)
+
+
+class PerBlock(Interpreter):
+    """Every block through Interpreter.execute (its short path
+    included), no read-execute loop (execute is overridden)."""
+
+    def execute(self, block) -> None:
+        Interpreter.execute(self, block)
+
+
+class TextLines:
+    """A TextCanon's output, kept."""
+
+    def __init__(self) -> None:
+        self.out: list[str] = []
+
+    def __call__(self, text: str) -> None:
+        self.out.append(text)
+
+
+def run_program(cls, text: str, canon_kind: str, path: str,
+                units: str = "mm", stream: bool = False) -> tuple:
+    """Run ``text`` (named ``path``; streamed from that file with
+    ``stream``) with an interpreter of ``cls``; everything that can be
+    compared."""
+    params = Parameters()
+    if canon_kind == "text":
+        written = TextLines()
+        canon = TextCanon(written)
+    else:
+        canon = canon_of(canon_kind == "ref")
+    interp = cls(params, None, canon, units=units)
+    if canon_kind == "text":
+        canon.interp = interp
+    program = Program.from_file(path, params) if stream else \
+        Program(text, path, params)
+    try:
+        interp.run(program)
+        error = None
+    except GCodeError as exc:
+        error = str(exc)
+    commands = written.out if canon_kind == "text" else canon.commands
+    return (error, commands, interp.pos, interp.feed, interp.feed_value,
+            interp.diameter_mode, vars(interp.modal), interp.line,
+            interp.params._numbered, interp.ended)
+
+
+number = st.sampled_from(["0", "1", "-2.5", "0.1234", "10", "-0.5", "3",
+                          "1.", ".5", "+2", "0.0001", "-7.25", "2"])
+axis_or_arc = st.sampled_from("xyzabcuvwijkrpXYZIJ")
+PLAIN = st.tuples(
+    st.sampled_from(["", "", "G0", "G1", "G2", "G3", "g1", "G01", "G1.0",
+                     "N5 G1", "n20 G0", "G1.00001"]),
+    st.lists(st.tuples(axis_or_arc, st.sampled_from(["", " "]), number),
+             max_size=5, unique_by=lambda w: w[0].lower()),
+    st.sampled_from(["", " ", "\t", "\r"]),
+).map(lambda t: (t[0] + " " + "".join(f"{a}{s}{v} " for a, s, v in t[1])
+                 ).strip() + t[2])
+#: half circles that the checks let through: incremental centre and end
+ARC = st.tuples(st.sampled_from(["G2", "G3", ""]), number, number,
+                st.sampled_from(["", " Z1", " Z-0.5 A3", " P2", " P1.5"])
+                ).map(lambda t: f"{t[0]} @1{2 * float(t[1]):g} "
+                      f"@2{2 * float(t[2]):g} @3{t[1]} @4{t[2]}{t[3]}")
+OTHER = st.sampled_from(SETUP_LINES + [
+    "", "   ", "N10", "(only a comment)", "G1 X1 F300", "M3 S1000",
+    "G1 X1 (with a comment)", "#1 = 2", "G1 X#1", "/G1 X9", "G0 X1 Y1 ; c",
+    "(MSG, hello)", "G91 G91.1 F100", "G90 G90.1", "G18", "G19", "G17",
+    "G2 X1 R1", "G20", "G21", "G55", "G54", "T1 M6", "G43 H1", "M5",
+    "G1 X(é)1", "G10 L20 P1 X0 Y0", "G92 Z-3", "G53 G0 X1"])
+PLANE_WORDS = {"G17": "XYIJ", "G18": "ZXKI", "G19": "YZJK"}
+
+
+def with_plane(lines: list[str]) -> list[str]:
+    """Fill in the arcs' words for the plane in effect at each line."""
+    plane = "G17"
+    out = []
+    for line in lines:
+        for code in PLANE_WORDS:
+            if code in line:
+                plane = code
+        for k, letter in enumerate(PLANE_WORDS[plane]):
+            line = line.replace(f"@{k + 1}", letter)
+        out.append(line)
+    return out
+
+
+PROGRAM = st.lists(st.one_of(PLAIN, PLAIN, ARC, ARC, OTHER), max_size=30
+                   ).map(with_plane)
+
+
+def check_program(text: str, canon_kind: str, units: str = "mm") -> None:
+    with tempfile.TemporaryDirectory() as folder:
+        path = os.path.join(folder, "p.ngc")
+        with open(path, "w", encoding="utf-8", newline="") as f:
+            f.write(text)
+        general = run_program(General, text, canon_kind, path, units)
+        for cls, stream in [(Interpreter, False), (PerBlock, False),
+                            (Interpreter, True)]:
+            assert run_program(cls, text, canon_kind, path, units,
+                               stream) == general, (cls, stream)
+
+
+@settings(max_examples=250, deadline=None)
+@given(st.lists(st.sampled_from(SETUP_LINES), max_size=6), PROGRAM,
+       st.sampled_from(["", "M2"]),
+       st.sampled_from(["rec", "rec", "ref", "text"]),
+       st.sampled_from(["mm", "inch"]))
+def test_programs_run_as_block_by_block(setup: list[str], body: list[str],
+                                        end: str, canon_kind: str,
+                                        units: str) -> None:
+    text = "\n".join(setup + ["G21 F100"] + body + [end]) + "\n"
+    check_program(text, canon_kind, units)
+
+
+@settings(max_examples=100, deadline=None)
+@given(PROGRAM, PROGRAM, st.sampled_from(["rec", "ref"]))
+def test_plain_moves_in_loops_and_subroutines(body: list[str],
+                                              main: list[str],
+                                              canon_kind: str) -> None:
+    # the lines of loops and subroutines are kept once read; a definition
+    # met in the main flow is skipped, its plain lines too
+    body = [line for line in body if "#" not in line]
+    text = "\n".join(
+        ["G21 G91 G91.1 F100", "o<s> sub"] + body + ["o<s> endsub"]
+        + main[:10] + ["#<n> = 0", "o1 while [#<n> LT 3]"] + body
+        + ["o<s> call", "#<n> = [#<n> + 1]", "o1 endwhile",
+           "o2 repeat [2]"] + main[10:] + ["o2 endrepeat", "M2"]) + "\n"
+    check_program(text, canon_kind)
+
+
+def test_the_loop_takes_plain_moves_and_hands_out_the_rest() -> None:
+    params = Parameters()
+    canon = RecordingCanon()
+    interp = Interpreter(params, None, canon)
+    text = ("G21 G90 F100\nG1 X1 Y2\nX3\nG0 Z1\n\nN7 G2 X5 I1\n"
+            "G1 X1 F200\nG1 Y1\nM2\n")
+    program = Program(text, "p.ngc", params)
+    handed = []
+    for block in program.blocks(interp):
+        handed.append(block.text)
+        interp.execute(block)
+    assert handed == ["G21 G90 F100", "G1 X1 F200", "M2"]
+    general = RecordingCanon()
+    General(Parameters(), None, general).run(Program(text, "p.ngc"))
+    assert canon.commands == general.commands
+    assert [c.line for c in canon.commands if c.line in (2, 3, 4, 6, 8)
+            ] == [2, 3, 4, 6, 8]
+    # without the interpreter every line with words is handed out
+    program = Program("G1 X1\nG1 X2\n", "p.ngc", Parameters())
+    assert [b.text for b in program.blocks()] == ["G1 X1", "G1 X2"]
+
+
+digits = st.text("0123456789", max_size=25)
+
+
+@settings(max_examples=500, deadline=None)
+@given(st.sampled_from(["", "+", "-"]), digits, st.booleans(), digits)
+def test_numbers_are_read_as_float_reads_them(sign: str, whole: str,
+                                              point: bool,
+                                              decimals: str) -> None:
+    # the compiled reader converts short numbers itself (an exact
+    # division), longer ones with Python's conversion: both are float()'s
+    text = sign + whole + ("." + decimals if point else "")
+    if not (whole or point and decimals):
+        return                                  # no digits: no number
+    read = _fast.simple_words(f"X{text}")
+    assert read is not None
+    value = read[1][0][1]
+    assert value == float(text)
+    assert str(value) == str(float(text))       # -0.0 too
