@@ -291,3 +291,39 @@ class Trace(Command):
     text: str
     kind: str = "call"
     line: int = 0
+
+
+@dataclass(frozen=True)
+class LogOpen(Command):
+    """``(LOGOPEN,name)`` (``append`` False: the file is emptied) or
+    ``(LOGAPPEND,name)``; ``path`` is the name as written."""
+    path: str
+    append: bool = False
+    line: int = 0
+
+
+@dataclass(frozen=True)
+class Log(Command):
+    """``(LOG,text)``: ``text`` with its parameters already expanded."""
+    text: str
+    line: int = 0
+
+
+@dataclass(frozen=True)
+class LogClose(Command):
+    """``(LOGCLOSE)``."""
+    line: int = 0
+
+
+@dataclass(frozen=True)
+class ProbeOpen(Command):
+    """``(PROBEOPEN name)``: the points of the following successful
+    probe moves go to ``path`` (emptied first), one line each."""
+    path: str
+    line: int = 0
+
+
+@dataclass(frozen=True)
+class ProbeClose(Command):
+    """``(PROBECLOSE)``."""
+    line: int = 0
