@@ -65,7 +65,7 @@ def last_comment(text: str) -> Optional[tuple[str, str]]:
 
 
 #: the active comments with a comma, as the reference recognises them
-_ACTIVE = ("msg", "debug", "print", "log", "logopen", "logappend")
+_ACTIVE = ("msg", "debug", "print", "log", "logopen", "logappend", "py")
 
 
 def comment_kind(body: str) -> tuple[str, str]:
@@ -303,11 +303,15 @@ class Interpreter:
 
     def _comment_trace(self, block: Block) -> None:
         """The last comment of the line, as the reference reports it."""
+        if self._py_line(block):
+            return
         found = last_comment(block.text)
         if found is None:
             return
         kind, text = found
-        if kind == "":
+        if kind == "py":
+            self._py_comment(text, block)
+        elif kind == "":
             self._trace(f'COMMENT("{text}")')
         elif kind == "msg":
             self._trace(f'MESSAGE("{text}")')
@@ -325,13 +329,18 @@ class Interpreter:
     def _comment_canon(self, block: Block) -> None:
         """The file comments of the line on a machine (see
         :func:`last_comment` and :func:`probe_comment`): LOG* and PROBE*
-        canon commands, which the machine's executor carries out."""
+        canon commands, which the machine's executor carries out; and the
+        Python comments (:meth:`_py_comment`)."""
+        if self._py_line(block):
+            return
         found = last_comment(block.text)
         if found is None:
             return
         kind, text = found
         line = self.line
-        if kind == "log":
+        if kind == "py":
+            self._py_comment(text, block)
+        elif kind == "log":
             self._emit(C.Log(self._substitute(text), line))
         elif kind in ("logopen", "logappend"):
             self._emit(C.LogOpen(text, kind == "logappend", line))
@@ -342,6 +351,20 @@ class Interpreter:
             if probe is not None:
                 self._emit(C.ProbeOpen(probe[1], line) if probe[0] == "open"
                            else C.ProbeClose(line))
+
+    def _py_line(self, block: Block) -> bool:
+        """A line that starts with ``;py,`` (nothing before it, lower
+        case) runs the Python statement after the comma; True if so."""
+        if not block.text.startswith(";py,"):
+            return False
+        self._py_comment(block.text[4:], block)
+        return True
+
+    def _py_comment(self, code: str, block: Block) -> None:
+        """Run ``;py,code`` or ``(py,code)`` in the namespace of the
+        ``[PYTHON]`` plugin (see :func:`halsdk.gcode.remap.py_comment`)."""
+        from .remap import py_comment
+        py_comment(self, code, block)
 
     def _substitute(self, text: str) -> str:
         def one(match: re.Match[str]) -> str:

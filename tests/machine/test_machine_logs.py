@@ -164,6 +164,8 @@ def test_a_file_that_cannot_be_opened_stops_the_program(
     ("LOGCLOSE ", "", "LOGCLOSE "),
     ("LOGCLOSE,x", "", "LOGCLOSE,x"),
     ("   plain  ", "", "plain  "),
+    ("py,x = 1", "py", "x = 1"),
+    ("PY, x", "py", " x"),
 ])
 def test_comment_kinds_as_the_reference_reads_them(body, kind, text):
     # checked against the reference's rs274 (tests/gcode/programs/glog)
@@ -179,3 +181,44 @@ def test_comment_kinds_as_the_reference_reads_them(body, kind, text):
 ])
 def test_probe_comments(text, found):
     assert probe_comment(text) == found
+
+
+def test_py_comments_run_in_the_plugin(hal, tmp_path: Path) -> None:
+    from halsdk.ini import IniFile
+    m = build(hal, tmp_path)
+    (tmp_path / "toplevel.py").write_text("lines = []\n")
+    ini = tmp_path / "machine.ini"
+    ini.write_text("[RS274NGC]\n[PYTHON]\nTOPLEVEL = toplevel.py\n")
+    m.configure_from_ini(IniFile(str(ini)))
+    turn_on(m)
+    out = tmp_path / "py.txt"
+    run_program(m, tmp_path, f"G21 G90 G0 X1\n;py,lines.append('a')\n"
+                "G0 X2 (py,lines += ['b'])\n"
+                "G0 X3 ;py,lines.append('not run')\n"
+                f";py,open({str(out)!r}, 'w').write(' '.join(lines))\nM2\n")
+    assert out.read_text() == "a b"
+    assert m.status().position[0] == pytest.approx(3, abs=1e-6)
+    # a Python error stops the program with its line
+    path = tmp_path / "bad.ngc"
+    path.write_text("G0 X1\n;py,1 / 0\nG0 X2\nM2\n")
+    m.program_open(str(path))
+    m.program_run()
+    with pytest.raises(MachineError, match=f"^{path}:2:1: py comment "
+                       "'1 / 0' raised ZeroDivisionError"):
+        m.wait_program(timeout=10)
+
+
+def test_a_py_comment_without_a_plugin_is_an_error(hal, tmp_path: Path
+                                                   ) -> None:
+    m = build(hal, tmp_path)
+    turn_on(m)
+    path = tmp_path / "part.ngc"
+    path.write_text("G0 X1\n;py,print('hello')\nM2\n")
+    m.mode(TaskMode.AUTO)
+    m.program_open(str(path))
+    m.program_run()
+    with pytest.raises(MachineError) as e:
+        m.wait_program(timeout=10)
+    assert str(e.value) == (f"{path}:2:1: a ;py, or (py,...) comment needs "
+                            "the [PYTHON] plugin of an INI file (TOPLEVEL=)")
+    assert ("error", str(e.value)) in m.errors()
