@@ -317,8 +317,8 @@ class LogClose(Command):
 
 @dataclass(frozen=True)
 class ProbeOpen(Command):
-    """``(PROBEOPEN name)``: the points of the following successful
-    probe moves go to ``path`` (emptied first), one line each."""
+    """``(PROBEOPEN name)``: where the following probe moves stopped
+    goes to ``path`` (emptied first), one line each."""
     path: str
     line: int = 0
 

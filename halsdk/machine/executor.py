@@ -84,6 +84,7 @@ class Executor(C.Canon):
         self.folder = ""
         self._log: Optional[IO[str]] = None
         self._probe_log: Optional[IO[str]] = None
+        self._last_record: Optional[tuple[float, ...]] = None
 
     # -- helpers -----------------------------------------------------------
 
@@ -196,8 +197,7 @@ class Executor(C.Canon):
         self.probes += 1
         if self.interp is not None:
             self.interp.probe_result(where, tripped)
-            if tripped:
-                self._probe_record()
+            self._probe_record()
             # the interpreter continues from where the move stopped
             self.interp.pos = list(self.pos)
         return True
@@ -390,12 +390,17 @@ class Executor(C.Canon):
             log.close()
 
     def _probe_record(self) -> None:
-        """The point of a successful probe (#5061..#5069: the program's
-        coordinates and units) as a line of the PROBEOPEN file."""
+        """Where a probe move stopped (#5061..#5069: the program's
+        coordinates and units) as a line of the PROBEOPEN file, unless
+        it is the point written last (the reference's rule)."""
         if self._probe_log is None or self.interp is None:
             return
         params = self.interp.params
-        text = " ".join(f"{params.get(5061 + i):f}" for i in range(9))
+        point = tuple(float(params.get(5061 + i)) for i in range(9))
+        if point == self._last_record:
+            return
+        self._last_record = point
+        text = " ".join(f"{v:f}" for v in point)
         self._write("PROBEOPEN", self._probe_log, text + "\n")
 
     def close_files(self) -> None:

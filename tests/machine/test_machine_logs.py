@@ -37,6 +37,8 @@ G38.3 Z#<depth> F600 (LOG,before the move X#5061)
 G0 Z20
 G38.3 Z15 F600
 (LOG,miss Z#5063 ok #5070)
+G0 Z20
+G38.3 Z15 F600
 (PROBECLOSE)
 G38.3 Z#<depth> F600
 G0 Z20
@@ -78,11 +80,13 @@ def test_log_and_probe_files_of_a_program(hal, tmp_path: Path) -> None:
         "miss Z15.000000 ok 0.000000",
         "last comment wins",
     ]
-    # one line per successful probe, nine numbers %f, program coordinates;
-    # the failed G38.3 and the probe after PROBECLOSE are not written
+    # one line per probe move, nine numbers %f, program coordinates, also
+    # where a G38.3 without contact stopped; not a point equal to the one
+    # written last (the second miss), nor after PROBECLOSE
     zero = " 0.000000" * 6
     assert probe.read_text() == (f"1.000000 2.000000 {z1:f}{zero}\n"
-                                 f"3.250000 2.000000 {z2:f}{zero}\n")
+                                 f"3.250000 2.000000 {z2:f}{zero}\n"
+                                 f"3.250000 2.000000 15.000000{zero}\n")
 
 
 def test_logappend_keeps_the_file_and_mdi_logs_too(hal, tmp_path: Path
