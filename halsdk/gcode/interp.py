@@ -44,8 +44,8 @@ _DEBUG_PARAM = re.compile(r"#\s*<([^>]*)>|#\s*(\d+)")
 
 def last_comment(text: str) -> Optional[tuple[str, str]]:
     """The last ``( )`` comment of a line as ``(kind, text)``: kind is
-    'msg', 'debug', 'print', 'log', 'logopen', 'logappend', 'logclose'
-    or '' (plain); see :func:`comment_kind`.  ``;`` ends the scan (the
+    'msg', 'debug', 'print', 'log', 'logopen', 'logappend', 'logclose',
+    'py' or '' (plain); see :func:`comment_kind`.  ``;`` ends the scan (the
     reference does not report ``;`` comments)."""
     found: Optional[tuple[str, str]] = None
     i = 0
@@ -94,6 +94,7 @@ def probe_comment(text: str) -> Optional[tuple[str, str]]:
     if text.startswith("PROBECLOSE"):
         return "close", ""
     return None
+
 
 AXES = "xyzabcuvw"
 ROTARY = (3, 4, 5)
@@ -424,8 +425,8 @@ class Interpreter:
         if self.ref and (block.comments or self.modal.feed_mode == 930
                          or AXIS_SET.isdisjoint(block.words)):
             return False
-        if block.comments and not self.ref:
-            return False            # maybe a LOG or PROBEOPEN comment
+        if block.comments:
+            return False            # maybe a LOG, PROBEOPEN or py comment
         return not self.params.get(5210 + 20 * self.coord_index)
 
     def _execute(self, block: Block) -> None:
