@@ -303,3 +303,39 @@ class Trace(Command):
     text: str
     kind: str = "call"
     line: int = 0
+
+
+@dataclass(frozen=True)
+class LogOpen(Command):
+    """``(LOGOPEN,name)`` (``append`` False: the file is emptied) or
+    ``(LOGAPPEND,name)``; ``path`` is the name as written."""
+    path: str
+    append: bool = False
+    line: int = 0
+
+
+@dataclass(frozen=True)
+class Log(Command):
+    """``(LOG,text)``: ``text`` with its parameters already expanded."""
+    text: str
+    line: int = 0
+
+
+@dataclass(frozen=True)
+class LogClose(Command):
+    """``(LOGCLOSE)``."""
+    line: int = 0
+
+
+@dataclass(frozen=True)
+class ProbeOpen(Command):
+    """``(PROBEOPEN name)``: where the following probe moves stopped
+    goes to ``path`` (emptied first), one line each."""
+    path: str
+    line: int = 0
+
+
+@dataclass(frozen=True)
+class ProbeClose(Command):
+    """``(PROBECLOSE)``."""
+    line: int = 0

@@ -47,9 +47,9 @@ _DEBUG_PARAM = re.compile(r"#\s*<([^>]*)>|#\s*(\d+)")
 
 def last_comment(text: str) -> Optional[tuple[str, str]]:
     """The last ``( )`` comment of a line as ``(kind, text)``: kind is
-    'msg', 'debug', 'print', 'log', 'logopen', 'logappend', 'logclose'
-    or '' (plain); the text after the comma is kept as written.  ``;``
-    ends the scan (the reference does not report ``;`` comments)."""
+    'msg', 'debug', 'print', 'log', 'logopen', 'logappend', 'logclose',
+    'py' or '' (plain); see :func:`comment_kind`.  ``;`` ends the scan (the
+    reference does not report ``;`` comments)."""
     found: Optional[tuple[str, str]] = None
     i = 0
     while i < len(text):
@@ -60,20 +60,44 @@ def last_comment(text: str) -> Optional[tuple[str, str]]:
             end = text.find(")", i + 1)
             if end < 0:
                 break
-            body = text[i + 1:end]
-            head, comma, rest = body.partition(",")
-            kind = "".join(head.split()).lower()
-            if comma and kind in ("msg", "debug", "print", "log",
-                                  "logopen", "logappend"):
-                found = (kind, rest)
-            elif kind == "logclose":
-                found = (kind, "")
-            else:
-                found = ("", body)
+            found = comment_kind(text[i + 1:end])
             i = end + 1
             continue
         i += 1
     return found
+
+
+#: the active comments with a comma, as the reference recognises them
+_ACTIVE = ("msg", "debug", "print", "log", "logopen", "logappend", "py")
+
+
+def comment_kind(body: str) -> tuple[str, str]:
+    """The kind and text of the comment ``body`` (between the brackets),
+    as the reference reads it: leading white space is skipped, then the
+    keyword and its comma must follow exactly (any case: ``( msg,x)``
+    but not ``(MSG ,x)`` or ``(M S G,x)``); ``logclose`` must be the
+    whole comment.  The text after the comma is kept as written; a plain
+    comment (kind '') loses its leading white space only."""
+    text = body.lstrip()
+    head, comma, rest = text.partition(",")
+    kind = head.lower()
+    if comma and kind in _ACTIVE:
+        return kind, rest
+    if text.lower() == "logclose":
+        return "logclose", ""
+    return "", text
+
+
+def probe_comment(text: str) -> Optional[tuple[str, str]]:
+    """``('open', name)`` for a plain comment ``PROBEOPEN name`` (upper
+    case, the name after the white space kept as written), ``('close',
+    '')`` for ``PROBECLOSE``, else None (the reference's rules)."""
+    if text.startswith("PROBEOPEN"):
+        return "open", text[len("PROBEOPEN"):].lstrip()
+    if text.startswith("PROBECLOSE"):
+        return "close", ""
+    return None
+
 
 AXES = "xyzabcuvw"
 ROTARY = (3, 4, 5)
@@ -293,11 +317,15 @@ class Interpreter:
 
     def _comment_trace(self, block: Block) -> None:
         """The last comment of the line, as the reference reports it."""
+        if self._py_line(block):
+            return
         found = last_comment(block.text)
         if found is None:
             return
         kind, text = found
-        if kind == "":
+        if kind == "py":
+            self._py_comment(text, block)
+        elif kind == "":
             self._trace(f'COMMENT("{text}")')
         elif kind == "msg":
             self._trace(f'MESSAGE("{text}")')
@@ -309,8 +337,48 @@ class Interpreter:
             self._trace(f'LOG("{self._substitute(text)}")')
         elif kind == "logclose":
             self._trace("LOGCLOSE()")
-        else:                       # logopen, logappend
-            self._trace(f'{kind.upper()}("{text.strip()}")')
+        else:                       # logopen, logappend: the name as is
+            self._trace(f'{kind.upper()}("{text}")')
+
+    def _comment_canon(self, block: Block) -> None:
+        """The file comments of the line on a machine (see
+        :func:`last_comment` and :func:`probe_comment`): LOG* and PROBE*
+        canon commands, which the machine's executor carries out; and the
+        Python comments (:meth:`_py_comment`)."""
+        if self._py_line(block):
+            return
+        found = last_comment(block.text)
+        if found is None:
+            return
+        kind, text = found
+        line = self.line
+        if kind == "py":
+            self._py_comment(text, block)
+        elif kind == "log":
+            self._emit(C.Log(self._substitute(text), line))
+        elif kind in ("logopen", "logappend"):
+            self._emit(C.LogOpen(text, kind == "logappend", line))
+        elif kind == "logclose":
+            self._emit(C.LogClose(line))
+        elif kind == "":
+            probe = probe_comment(text)
+            if probe is not None:
+                self._emit(C.ProbeOpen(probe[1], line) if probe[0] == "open"
+                           else C.ProbeClose(line))
+
+    def _py_line(self, block: Block) -> bool:
+        """A line that starts with ``;py,`` (nothing before it, lower
+        case) runs the Python statement after the comma; True if so."""
+        if not block.text.startswith(";py,"):
+            return False
+        self._py_comment(block.text[4:], block)
+        return True
+
+    def _py_comment(self, code: str, block: Block) -> None:
+        """Run ``;py,code`` or ``(py,code)`` in the namespace of the
+        ``[PYTHON]`` plugin (see :func:`halsdk.gcode.remap.py_comment`)."""
+        from .remap import py_comment
+        py_comment(self, code, block)
 
     def _substitute(self, text: str) -> str:
         def one(match: re.Match[str]) -> str:
@@ -376,6 +444,8 @@ class Interpreter:
         if self.ref and (block.comments or self.modal.feed_mode == 930
                          or AXIS_SET.isdisjoint(block.words)):
             return False
+        if block.comments:
+            return False            # maybe a LOG, PROBEOPEN or py comment
         return not self.params.get(5210 + 20 * self.coord_index)
 
     def _execute(self, block: Block) -> None:
@@ -391,6 +461,8 @@ class Interpreter:
             self._comment_trace(block)
         elif block.message:
             self._emit(C.Message(block.message, line))
+        if block.comments and not ref:
+            self._comment_canon(block)
         if 14 in gs:
             self._spindle_mode(block, gs[14])
         if 5 in gs:

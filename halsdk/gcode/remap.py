@@ -658,5 +658,28 @@ def python_sub(interp: Any, name: str
     return call
 
 
+def py_comment(interp: Any, code: str, block: Block) -> None:
+    """Run the Python statement(s) ``code`` of a ``;py,`` line or a
+    ``(py,...)`` comment in the namespace of ``interp``'s ``[PYTHON]
+    TOPLEVEL`` script (its globals: what it defines is seen, what the
+    statement assigns stays), as the reference does.  Without a plugin
+    it is an error (the reference runs it in a namespace of its own)."""
+    remapper = getattr(interp, "remap", None)
+    if remapper is None or remapper.plugin is None:
+        raise block.error("a ;py, or (py,...) comment needs the [PYTHON] "
+                          "plugin of an INI file (TOPLEVEL=)")
+    plugin = remapper.plugin
+    what = f"py comment {code.strip()!r}"
+    try:
+        compiled = compile(code, "<py comment>", "exec")
+        with plugin.running(remapper._view(interp)):
+            exec(compiled, plugin.namespace)
+    except GCodeError:
+        raise
+    except Exception as exc:
+        raise python_failure(exc, what, block.file, block.line, 1) from None
+
+
 __all__ = ["MAX_REMAP_LEVEL", "Remap", "RemapError", "Remapper",
-           "configure", "parse_remap", "python_sub", "PluginError"]
+           "configure", "parse_remap", "py_comment", "python_sub",
+           "PluginError"]

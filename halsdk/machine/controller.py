@@ -255,6 +255,7 @@ class TaskController:
             self.axis_mask = sum(1 << "XYZABCUVW".index(c)
                                  for c in set(letters))
         folder = os.path.dirname(self.ini_filename)
+        self.executor.folder = folder       # LOGOPEN/PROBEOPEN names
         self.subroutine_path = subroutine_path(ini) or self.subroutine_path
         self.max_iterations = int(_ini_limit(
             ini, "HALSDK_MAX_ITERATIONS", self.max_iterations, True))

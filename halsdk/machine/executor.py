@@ -17,8 +17,9 @@ in here blocks: a waiting command is tried again at the next pump.
 from __future__ import annotations
 
 import math
+import os
 from collections import deque
-from typing import Any, Callable, Optional
+from typing import IO, Any, Callable, Optional
 
 from halsdk.gcode import canon as C
 from halsdk.machine.iocontrol import ToolState
@@ -82,6 +83,12 @@ class Executor(C.Canon):
         #: seconds a user M-code (M100-M199) may run
         self.user_m_timeout = DEFAULT_TIMEOUT
         self._user_m: Optional[UserMRun] = None
+        #: the folder relative LOGOPEN/PROBEOPEN names are in (the INI
+        #: file's, as the reference's task runs there; '' the current one)
+        self.folder = ""
+        self._log: Optional[IO[str]] = None
+        self._probe_log: Optional[IO[str]] = None
+        self._last_record: Optional[tuple[float, ...]] = None
 
     # -- helpers -----------------------------------------------------------
 
@@ -197,6 +204,7 @@ class Executor(C.Canon):
         self.probes += 1
         if self.interp is not None:
             self.interp.probe_result(where, tripped)
+            self._probe_record()
             # the interpreter continues from where the move stopped
             self.interp.pos = list(self.pos)
         return True
@@ -355,3 +363,70 @@ class Executor(C.Canon):
 
     def _do_Message(self, c: C.Message) -> None:
         self.message("display", c.text)
+
+    # -- log files (LOGOPEN, LOG, PROBEOPEN ...) ----------------------------
+
+    def _open(self, what: str, name: str, mode: str) -> IO[str]:
+        path = os.path.join(self.folder, name)
+        try:
+            return open(path, mode, encoding="utf-8")
+        except OSError as e:
+            raise ExecutorError(f"{what}: cannot open '{name}' ({path}): "
+                                f"{e.strerror}") from None
+
+    @staticmethod
+    def _write(what: str, file: IO[str], text: str) -> None:
+        try:
+            file.write(text)
+            file.flush()
+        except OSError as e:
+            raise ExecutorError(f"{what}: cannot write to '{file.name}': "
+                                f"{e.strerror}") from None
+
+    def _do_LogOpen(self, c: C.LogOpen) -> None:
+        what = "LOGAPPEND" if c.append else "LOGOPEN"
+        self._close_log()
+        self._log = self._open(what, c.path, "a" if c.append else "w")
+
+    def _do_Log(self, c: C.Log) -> None:
+        if self._log is not None:
+            self._write("LOG", self._log, c.text + "\n")
+
+    def _do_LogClose(self, c: C.LogClose) -> None:
+        self._close_log()
+
+    def _close_log(self) -> None:
+        log, self._log = self._log, None
+        if log is not None:
+            log.close()
+
+    def _do_ProbeOpen(self, c: C.ProbeOpen) -> None:
+        self._close_probe_log()
+        self._probe_log = self._open("PROBEOPEN", c.path, "w")
+
+    def _do_ProbeClose(self, c: C.ProbeClose) -> None:
+        self._close_probe_log()
+
+    def _close_probe_log(self) -> None:
+        log, self._probe_log = self._probe_log, None
+        if log is not None:
+            log.close()
+
+    def _probe_record(self) -> None:
+        """Where a probe move stopped (#5061..#5069: the program's
+        coordinates and units) as a line of the PROBEOPEN file, unless
+        it is the point written last (the reference's rule)."""
+        if self._probe_log is None or self.interp is None:
+            return
+        params = self.interp.params
+        point = tuple(float(params.get(5061 + i)) for i in range(9))
+        if point == self._last_record:
+            return
+        self._last_record = point
+        text = " ".join(f"{v:f}" for v in point)
+        self._write("PROBEOPEN", self._probe_log, text + "\n")
+
+    def close_files(self) -> None:
+        """Close the LOGOPEN and PROBEOPEN files (the machine stops)."""
+        self._close_log()
+        self._close_probe_log()

@@ -24,6 +24,7 @@ the difference; they are strict xfails, so a fix shows up as XPASS.
 
 from __future__ import annotations
 
+import contextlib
 import io
 import os
 import re
@@ -130,12 +131,14 @@ def ours_all(prog: Path, tmp_path: Path) -> tuple[str, int, str]:
     extra = prog.with_suffix(".args")
     options = extra.read_text().split() if extra.exists() else []
     assert set(options) <= {"-b", "-n", "0", "2"}, options
-    status = run(prog.read_text(encoding="utf-8"), str(prog), out.write,
-                 err.write, tool_file=str(tbl) if tbl.exists() else None,
-                 var_file=var_file, search_path=(str(prog.parent),),
-                 ini=IniFile(str(ini)) if ini.exists() else None,
-                 block_delete="-b" in options,
-                 keep_going="-n 0" in " ".join(options))
+    # what Python comments print goes to the same standard output
+    with contextlib.redirect_stdout(out):
+        status = run(prog.read_text(encoding="utf-8"), str(prog), out.write,
+                     err.write, tool_file=str(tbl) if tbl.exists() else None,
+                     var_file=var_file, search_path=(str(prog.parent),),
+                     ini=IniFile(str(ini)) if ini.exists() else None,
+                     block_delete="-b" in options,
+                     keep_going="-n 0" in " ".join(options))
     return out.getvalue(), status, err.getvalue()
 
 
