@@ -72,6 +72,9 @@ class Parameters:
         self._numbered: dict[int, float] = {}
         self._globals: dict[str, float] = {}
         self._frames: list[_Frame] = [_Frame()]
+        #: the current scope, ``_frames[-1]`` (read by the compiled
+        #: evaluator, halsdk/gcode/_eval.pyx)
+        self._top = self._frames[0]
         self._predefined: Optional[Callable[[str], Optional[float]]] = None
         self._saved: set[int] = set()
 
@@ -90,15 +93,18 @@ class Parameters:
         for index, value in enumerate(args or (), start=1):
             frame.numbered[index] = float(value)
         self._frames.append(frame)
+        self._top = frame
 
     def pop_scope(self) -> None:
         """Leave a subroutine: its locals vanish."""
         if len(self._frames) > 1:
             self._frames.pop()
+            self._top = self._frames[-1]
 
     def reset_scopes(self) -> None:
         """Drop every open subroutine scope (after an error or abort)."""
         del self._frames[1:]
+        self._top = self._frames[0]
 
     # -- predefined ------------------------------------------------------
     def set_predefined(self, fn: Optional[Callable[[str], Optional[float]]]

@@ -10,6 +10,7 @@ from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from typing import BinaryIO, Optional, Union
 
+from ._eval import evaluate
 from ._fast import EMPTY, read_line, set_file_lines
 from .block import Block, code_key
 from .errors import GCodeError
@@ -527,7 +528,7 @@ class Program:
 
     # -- evaluation helpers ------------------------------------------------
     def _value(self, expr: Expr, line: Line) -> float:
-        return expr.evaluate(self.params, Where(line.file, line.number))
+        return evaluate(expr, self.params, line.file, line.number)
 
     def _set(self, key: int | str, value: float, line: Line,
              column: int) -> None:
@@ -553,9 +554,9 @@ class Program:
                       block_delete=line.block_delete,
                       line_number=line.line_number)
         params = self.params
-        where = Where(line.file, line.number)
+        file, number = line.file, line.number
         for word in line.words:
-            value = word.value.evaluate(params, where)
+            value = evaluate(word.value, params, file, number)
             if word.letter in "gm":
                 value = round(value, 4)
                 key = code_key(word.letter, value)
@@ -566,7 +567,7 @@ class Program:
                 block.words[word.letter] = value
                 block.columns[word.letter] = word.column
         values = [(self._parameter_key(a.target, line),
-                   a.value.evaluate(params, where), a.column)
+                   evaluate(a.value, params, file, number), a.column)
                   for a in line.assignments]
         for param, value, column in values:
             self._set(param, value, line, column)
