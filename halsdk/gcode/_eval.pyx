@@ -220,9 +220,9 @@ cdef class Func(Node):
                 raise GIVE_UP
             r = exp(x)
         elif code == F_FIX:
-            r = floor(x)
+            r = floor(x) + 0.0      # math.floor gives an int: no -0.0
         elif code == F_FUP:
-            r = ceil(x)
+            r = ceil(x) + 0.0
         elif code == F_ROUND:
             r = floor(fabs(x) + 0.5)
             if not x >= 0:
@@ -303,7 +303,7 @@ cdef class Bin(Node):
             if (a >= 0) == (b >= 0):
                 r = fmod(a, b)
             else:
-                r = a - b * floor(a / b)
+                r = a - b * (floor(a / b) + 0.0)
         elif op == OP_POW:
             # Python's float power, for a positive finite base
             if not (a > 0 and isfinite(a) and isfinite(b)):
@@ -402,3 +402,116 @@ cpdef double evaluate(object expr, object params, str file,
         return node.ev(params)
     except _GiveUp:
         return expr.evaluate(params, Where(file, line))
+
+
+# -- the blocks of general lines ---------------------------------------------
+
+import builtins
+import dataclasses
+
+from .block import Block, code_key
+from .errors import GCodeError
+from .params import POSITION, READ_ONLY
+
+cdef object _round = builtins.round
+cdef object _new = object.__new__
+cdef tuple _BLOCK_FIELDS = ("file", "line", "text", "g", "m", "words",
+                            "columns", "comments", "message",
+                            "block_delete", "line_number")
+#: Block is a dataclass whose __init__ only stores its fields: a block
+#: may be made by filling its __dict__
+cdef bint _DIRECT_BLOCK = (
+    tuple(f.name for f in dataclasses.fields(Block)) == _BLOCK_FIELDS
+    and not hasattr(Block, "__post_init__")
+    and "__slots__" not in Block.__dict__)
+cdef long _READ_ONLY_FIRST = READ_ONLY[0]
+cdef long _READ_ONLY_LAST = READ_ONLY[-1]
+cdef long _POSITION_FIRST = POSITION[0]
+cdef long _POSITION_LAST = POSITION[-1]
+
+
+cdef bint _assign(object params, object key, double value) except -1:
+    """``params.set(key, value)`` for a local name or a writable
+    parameter number; False (nothing done) for any other key."""
+    cdef long number
+    cdef str name
+    if type(key) is str:
+        name = normalize_name(key)
+        if not name or name[0] == "_":
+            return False        # an error, or a global: params.set
+        (<dict>params._top.named)[name] = value
+        return True
+    if type(key) is int:
+        if not 1 <= key <= MAX_PARAMETER:   # (a Python int of any size)
+            return False
+        number = key
+        if _READ_ONLY_FIRST <= number <= _READ_ONLY_LAST or \
+                _POSITION_FIRST <= number <= _POSITION_LAST:
+            return False
+        if number <= 30 and len(<list>params._frames) > 1:
+            (<dict>params._top.numbered)[key] = value
+        else:
+            (<dict>params._numbered)[key] = value
+        return True
+    return False
+
+
+def make_block(object program, object line):
+    """``Program._block(line)``: the words of ``line`` evaluated into a
+    :class:`Block`, its assignments applied."""
+    cdef object params = program.params
+    cdef str file = line.file
+    cdef long number = line.number
+    cdef list g = [], m = [], values = []
+    cdef dict words = {}, columns = {}
+    cdef list comments = []
+    cdef object message = None
+    cdef object word, value, key, a, comment, block
+    cdef str letter, kind
+    cdef double v
+    if _DIRECT_BLOCK:
+        block = _new(Block)
+    else:
+        block = Block(file, number, line.text)
+    for word in line.words:
+        letter = word.letter
+        v = evaluate(word.value, params, file, number)
+        if letter == "g" or letter == "m":
+            value = _round(v, 4)
+            key = code_key(letter, value)
+            if letter == "g":
+                g.append(value)
+            else:
+                m.append(value)
+            columns.setdefault(key, word.column)
+            columns.setdefault(letter, word.column)
+        else:
+            words[letter] = v
+            columns[letter] = word.column
+    for a in line.assignments:
+        values.append((program._parameter_key(a.target, line),
+                       evaluate(a.value, params, file, number), a.column))
+    for key, value, column in values:
+        if not _assign(params, key, value):
+            program._set(key, value, line, column)
+    for comment in line.comments:
+        kind = comment.kind
+        if kind == "msg":
+            message = comment.text
+        elif kind == "debug" or kind == "print":
+            message = program._debug_text(comment.text).strip()
+        else:
+            comments.append(comment.text)
+    d = block.__dict__
+    d["file"] = file
+    d["line"] = number
+    d["text"] = line.text
+    d["g"] = g
+    d["m"] = m
+    d["words"] = words
+    d["columns"] = columns
+    d["comments"] = comments
+    d["message"] = message
+    d["block_delete"] = line.block_delete
+    d["line_number"] = line.line_number
+    return block

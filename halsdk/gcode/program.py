@@ -10,7 +10,7 @@ from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from typing import BinaryIO, Optional, Union
 
-from ._eval import evaluate
+from ._eval import evaluate, make_block
 from ._fast import EMPTY, read_line, set_file_lines
 from .block import Block, code_key
 from .errors import GCodeError
@@ -550,6 +550,10 @@ class Program:
 
     def _block(self, line: Line) -> Block:
         """Evaluate the words of ``line`` and apply its assignments."""
+        return make_block(self, line)
+
+    def _block_python(self, line: Line) -> Block:
+        """:meth:`_block` in Python: the reference of its behaviour."""
         block = Block(line.file, line.number, line.text,
                       block_delete=line.block_delete,
                       line_number=line.line_number)
@@ -614,6 +618,7 @@ class Program:
         seen_code = False
         clock = self.clock
         structure = unit.structure
+        params = self.params
         while True:
             entry = read_line(unit, index)
             if entry is None:
@@ -622,7 +627,8 @@ class Program:
                         f"end of file inside {_label(frames[-1].name)}",
                         unit.file, unit.count, 1)
                 return
-            if not frames and structure.sub_starts:
+            if not frames and structure.sub_starts and \
+                    structure.sub_starts[0] <= index <= structure.sub_ends[-1]:
                 end = structure.sub_end(index)
                 if end >= 0:
                     # a subroutine definition met in the main flow: skip it
@@ -657,11 +663,11 @@ class Program:
             oword = line.oword
             if oword is None:
                 index += 1
-                if line.empty:
-                    continue
                 if line.words:
                     seen_code = True
-                block = self._block(line)
+                elif not (line.assignments or line.comments):
+                    continue    # an empty line
+                block = make_block(self, line)
                 working = bool(block.g or block.m or block.words
                                or block.message is not None)
                 if working or block.comments:
@@ -671,17 +677,16 @@ class Program:
                         self._idle_since = clock()
                     else:   # the time the consumer held it is not idle
                         self._idle_since += clock() - handed
-                if any(abs(m - 2) < 1e-6 or abs(m - 30) < 1e-6
-                       for m in block.m):
+                if block.m and any(abs(m - 2) < 1e-6 or abs(m - 30) < 1e-6
+                                   for m in block.m):
                     return
                 continue
             seen_code = True
             keyword = oword.keyword
-            frame_key = id(frames[-1]) if frames else 0
 
             if keyword == "call":
                 name = oword.name if isinstance(oword.name, str) else \
-                    f"{self._value(oword.name, line):g}"
+                    f"{evaluate(oword.name, params, line.file, line.number):g}"
                 target = self._find_sub(name, unit)
                 if target is None:
                     raise GCodeError(f"unknown subroutine {_label(name)}",
@@ -691,7 +696,8 @@ class Program:
                                      f"{self.max_call_depth}", line.file,
                                      line.number, oword.column)
                 self._count(unit, index, "subroutine call")
-                args = [self._value(a, line) for a in oword.args]
+                args = [evaluate(a, params, line.file, line.number)
+                        for a in oword.args]
                 if len(args) > 30:
                     raise GCodeError("at most 30 subroutine arguments",
                                      line.file, line.number, oword.column)
@@ -705,12 +711,13 @@ class Program:
                 if keyword == "endsub" and not frames:
                     index += 1
                     continue
-                returned = self._value(oword.args[0], line) \
-                    if oword.args else None
+                returned = evaluate(oword.args[0], params, line.file,
+                                    line.number) if oword.args else None
                 frame = frames.pop()
-                self.params.pop_scope()
-                for key in [k for k in repeats if k[0] == id(frame)]:
-                    del repeats[key]
+                params.pop_scope()
+                if repeats:
+                    for key in [k for k in repeats if k[0] == id(frame)]:
+                        del repeats[key]
                 if returned is not None:
                     self.params.set("_value", returned)
                     self.params.set("_value_returned", 1.0)
@@ -729,13 +736,13 @@ class Program:
             elif keyword == "while" and index in structure.loop_start:
                 # the closing "while" of a do loop
                 opener = structure.loop_start[index]
-                if self._value(oword.args[0], line):
+                if evaluate(oword.args[0], params, line.file, line.number):
                     self._count(unit, opener, "loop")
                     index = opener + 1
                 else:
                     index += 1
             elif keyword == "while":
-                if self._value(oword.args[0], line):
+                if evaluate(oword.args[0], params, line.file, line.number):
                     self._count(unit, index, "loop")
                     index += 1
                 else:
@@ -744,8 +751,9 @@ class Program:
                 self._count(unit, index, "loop")
                 index += 1
             elif keyword == "repeat":
-                count = int(self._value(oword.args[0], line))
-                repeats[(frame_key, index)] = count
+                count = int(evaluate(oword.args[0], params, line.file,
+                                     line.number))
+                repeats[(id(frames[-1]) if frames else 0, index)] = count
                 if count <= 0:
                     index = structure.loop_end[index] + 1
                 else:
@@ -753,7 +761,7 @@ class Program:
                     index += 1
             elif keyword == "endrepeat":
                 opener = structure.loop_start[index]
-                key = (frame_key, opener)
+                key = (id(frames[-1]) if frames else 0, opener)
                 repeats[key] -= 1
                 if repeats[key] > 0:
                     self._count(unit, opener, "loop")
@@ -765,7 +773,7 @@ class Program:
                 index = structure.loop_start[index]
             elif keyword == "break":
                 opener = structure.loop_of[index]
-                repeats.pop((frame_key, opener), None)
+                repeats.pop((id(frames[-1]) if frames else 0, opener), None)
                 index = structure.loop_end[opener] + 1
             elif keyword == "continue":
                 opener = structure.loop_of[index]

@@ -206,3 +206,43 @@ def test_program_runs_values_through_the_compiled_evaluator() -> None:
     assert blocks == [{"x": 0.0, "y": 0.0}, {"x": 2.0, "y": 1.0},
                       {"x": 4.0, "y": math.sqrt(2)}, {"x": 0.0}]
     assert error == "w.ngc:8:7: division by zero"
+
+
+ASSIGN_LINE = st.builds(
+    lambda parts: " ".join(parts),
+    st.lists(st.sampled_from([
+        "G1", "G38.2", "M3", "M2", "X[#1 + 1]", "Y#<a>", "#1=[#2 + 1]",
+        "#<a>=[#1 * 2]", "#<A B>=3", "#<_g>=[#<_g> + 1]", "#5400=1",
+        "#5421=2", "#[#2]=4", "#[0.5]=1", "#31=[#1]", "#<_x>=1",
+        "(msg, hello)", "(debug, a #1 #<a> #<zz>)", "(print,#<_g>)",
+        "(plain)", "Z[#<nothing>]", "F[1/0]",
+    ]), max_size=6, unique=True))
+
+
+def block_outcome(program: Program, line: object, compiled: bool) -> object:
+    try:
+        block = program._block(line) if compiled else \
+            program._block_python(line)
+    except GCodeError as exc:
+        result: object = str(exc)
+    else:
+        result = vars(block)
+    params = program.params
+    return (result, params._numbered, params._globals,
+            [(f.numbered, f.named) for f in params._frames])
+
+
+@settings(max_examples=500, deadline=None)
+@given(ASSIGN_LINE, st.integers(0, 1), st.lists(VALUE, min_size=4,
+                                                 max_size=4))
+def test_compiled_block_agrees(text: str, depth: int,
+                               values: list[float]) -> None:
+    try:
+        line = lexer.parse_line_python(text, "b.ngc", 2)
+    except GCodeError:
+        return          # two words of a letter
+    outcomes = []
+    for compiled in (True, False):
+        program = Program("", "b.ngc", make_params(depth, values))
+        outcomes.append(block_outcome(program, line, compiled))
+    assert outcomes[0] == outcomes[1]
