@@ -489,7 +489,10 @@ def make_block(object program, object line):
             words[letter] = v
             columns[letter] = word.column
     for a in line.assignments:
-        values.append((program._parameter_key(a.target, line),
+        key = a.target.index        # ParamRef.key of a name: the name
+        if type(key) is not str:
+            key = program._parameter_key(a.target, line)
+        values.append((key,
                        evaluate(a.value, params, file, number), a.column))
     for key, value, column in values:
         if not _assign(params, key, value):

@@ -192,6 +192,14 @@ class Parameters:
         else:
             self._numbered[number] = value
 
+    def set_returned(self, value: Optional[float]) -> None:
+        """What a subroutine call (None) or return sets: ``#<_value>``
+        (when it returns a value) and ``#<_value_returned>``, globals of
+        the program's own, stored without the checks of :meth:`set`."""
+        if value is not None:
+            self._globals["_value"] = float(value)
+        self._globals["_value_returned"] = 0.0 if value is None else 1.0
+
     def exists(self, name: str) -> bool:
         """True if the named parameter ``name`` can be read now."""
         name = normalize_name(name)

@@ -701,8 +701,8 @@ class Program:
                 if len(args) > 30:
                     raise GCodeError("at most 30 subroutine arguments",
                                      line.file, line.number, oword.column)
-                self.params.set("_value_returned", 0.0)
-                self.params.push_scope(args)
+                params.set_returned(None)
+                params.push_scope(args)
                 frames.append(_Frame(unit, index + 1, name))
                 unit = target
                 structure = unit.structure
@@ -718,11 +718,7 @@ class Program:
                 if repeats:
                     for key in [k for k in repeats if k[0] == id(frame)]:
                         del repeats[key]
-                if returned is not None:
-                    self.params.set("_value", returned)
-                    self.params.set("_value_returned", 1.0)
-                else:
-                    self.params.set("_value_returned", 0.0)
+                params.set_returned(returned)
                 unit, index = frame.return_unit, frame.return_index
                 structure = unit.structure
             elif keyword == "sub":
