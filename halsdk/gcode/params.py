@@ -135,6 +135,11 @@ class Parameters:
 
     def get(self, key: Key) -> float:
         """The value of parameter ``key`` (a number or a name)."""
+        if key.__class__ is int and (
+                LOCAL_NUMBERED[-1] < key < POSITION[0]
+                or POSITION[-1] < key <= MAX_PARAMETER):
+            # neither local nor position nor out of range: stored
+            return self._numbered.get(key, 0.0)
         if isinstance(key, str):
             name = normalize_name(key)
             value = self._predefined_value(name)
