@@ -456,6 +456,25 @@ cdef bint _assign(object params, object key, double value) except -1:
     return False
 
 
+def assign(object program, object line):
+    """What ``make_block(program, line)`` does to a line of assignments
+    only (no words, no comments): apply them."""
+    cdef object params = program.params
+    cdef str file = line.file
+    cdef long number = line.number
+    cdef list values = []
+    cdef object key, a, value
+    for a in line.assignments:
+        key = a.target.index
+        if type(key) is not str:
+            key = program._parameter_key(a.target, line)
+        values.append((key, evaluate(a.value, params, file, number),
+                       a.column))
+    for key, value, column in values:
+        if not _assign(params, key, value):
+            program._set(key, value, line, column)
+
+
 def make_block(object program, object line):
     """``Program._block(line)``: the words of ``line`` evaluated into a
     :class:`Block`, its assignments applied."""

@@ -27,7 +27,9 @@ class _Fail(Exception):
 
 
 cdef object FAIL = _Fail()
-cdef frozenset _KEYWORDS = frozenset(O_KEYWORDS)
+#: the keywords, by their text: the strings of O_KEYWORDS, so that the
+#: control flow compares them by identity first
+cdef dict _KEYWORDS = {k: k for k in O_KEYWORDS}
 cdef frozenset _WITH_ARGS = frozenset(("if", "elseif", "while", "repeat",
                                        "return", "endsub", "call"))
 cdef frozenset _FUNCTIONS = frozenset(FUNCTIONS)
@@ -303,8 +305,8 @@ cdef class _Reader:
             name = format(self.unsigned_number(), "g")
         else:
             raise FAIL
-        keyword = self.word()
-        if keyword not in _KEYWORDS:
+        keyword = _KEYWORDS.get(self.word())
+        if keyword is None:
             raise FAIL
         if keyword in _WITH_ARGS:
             while self.peek() == 91:

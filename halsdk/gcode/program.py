@@ -10,7 +10,7 @@ from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from typing import BinaryIO, Optional, Union
 
-from ._eval import evaluate, make_block
+from ._eval import assign, evaluate, make_block
 from ._fast import EMPTY, read_line, set_file_lines
 from .block import Block, code_key
 from .errors import GCodeError
@@ -665,8 +665,10 @@ class Program:
                 index += 1
                 if line.words:
                     seen_code = True
-                elif not (line.assignments or line.comments):
-                    continue    # an empty line
+                elif not line.comments:
+                    if line.assignments:
+                        assign(self, line)      # no block to hand out
+                    continue
                 block = make_block(self, line)
                 working = bool(block.g or block.m or block.words
                                or block.message is not None)
