@@ -165,6 +165,14 @@ components.append(Extension(
     "halsdk.gcode._fast", sources=["halsdk/gcode/_fast.pyx"],
     # no fused multiply-add: the same rounding as Python's arithmetic
     extra_compile_args=FLAGS + ["-ffp-contract=off"]))
+# the compiled lexer and expression evaluator (halsdk/gcode/_lex.pyx,
+# _eval.pyx); the Python lexer and trees stay the reference of behaviour
+components.append(Extension(
+    "halsdk.gcode._lex", sources=["halsdk/gcode/_lex.pyx"],
+    extra_compile_args=FLAGS))
+components.append(Extension(
+    "halsdk.gcode._eval", sources=["halsdk/gcode/_eval.pyx"],
+    extra_compile_args=FLAGS + ["-ffp-contract=off"]))
 names = [e.name for e in components]
 if len(set(names)) != len(names):
     sys.exit("error: two sources in components/ make the same module")

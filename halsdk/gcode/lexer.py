@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field
-from typing import Optional
+from typing import Callable, Optional
 
 from .errors import GCodeError
 from .expr import (
@@ -263,7 +263,21 @@ def _comment(body: str, column: int) -> Comment:
 
 
 def parse_line(text: str, file: str = "<string>", lineno: int = 1) -> Line:
-    """Read one line of G-code; raises :class:`GCodeError` with its column."""
+    """Read one line of G-code; raises :class:`GCodeError` with its column.
+
+    The compiled lexer (``_lex.pyx``) reads the lines it can; any other
+    line, and every line with an error, is read by
+    :func:`parse_line_python`, which says what is wrong."""
+    if _compiled_parse_line is not None:
+        line = _compiled_parse_line(text, file, lineno)
+        if line is not None:
+            return line
+    return parse_line_python(text, file, lineno)
+
+
+def parse_line_python(text: str, file: str = "<string>",
+                      lineno: int = 1) -> Line:
+    """:func:`parse_line` in Python: the reference of its behaviour."""
     text = text.rstrip("\r\n")
     reader: _Reader
     if text.isascii():
@@ -566,3 +580,10 @@ def _oword(reader: _Reader) -> OWord:
     if keyword in ("return", "endsub") and len(args) > 1:
         raise reader.error("Unexpected character after O-word")
     return OWord(name, keyword, args, column)
+
+
+_compiled_parse_line: Optional[Callable[[str, str, int], Optional[Line]]]
+try:
+    from ._lex import parse_line as _compiled_parse_line
+except ImportError:     # pragma: no cover - not built: Python only
+    _compiled_parse_line = None

@@ -72,6 +72,9 @@ class Parameters:
         self._numbered: dict[int, float] = {}
         self._globals: dict[str, float] = {}
         self._frames: list[_Frame] = [_Frame()]
+        #: the current scope, ``_frames[-1]`` (read by the compiled
+        #: evaluator, halsdk/gcode/_eval.pyx)
+        self._top = self._frames[0]
         self._predefined: Optional[Callable[[str], Optional[float]]] = None
         self._saved: set[int] = set()
 
@@ -90,15 +93,18 @@ class Parameters:
         for index, value in enumerate(args or (), start=1):
             frame.numbered[index] = float(value)
         self._frames.append(frame)
+        self._top = frame
 
     def pop_scope(self) -> None:
         """Leave a subroutine: its locals vanish."""
         if len(self._frames) > 1:
             self._frames.pop()
+            self._top = self._frames[-1]
 
     def reset_scopes(self) -> None:
         """Drop every open subroutine scope (after an error or abort)."""
         del self._frames[1:]
+        self._top = self._frames[0]
 
     # -- predefined ------------------------------------------------------
     def set_predefined(self, fn: Optional[Callable[[str], Optional[float]]]
@@ -128,6 +134,11 @@ class Parameters:
 
     def get(self, key: Key) -> float:
         """The value of parameter ``key`` (a number or a name)."""
+        if key.__class__ is int and (
+                LOCAL_NUMBERED[-1] < key < POSITION[0]
+                or POSITION[-1] < key <= MAX_PARAMETER):
+            # neither local nor position nor out of range: stored
+            return self._numbered.get(key, 0.0)
         if isinstance(key, str):
             name = normalize_name(key)
             value = self._predefined_value(name)
@@ -185,6 +196,14 @@ class Parameters:
             self._frames[-1].numbered[number] = value
         else:
             self._numbered[number] = value
+
+    def set_returned(self, value: Optional[float]) -> None:
+        """What a subroutine call (None) or return sets: ``#<_value>``
+        (when it returns a value) and ``#<_value_returned>``, globals of
+        the program's own, stored without the checks of :meth:`set`."""
+        if value is not None:
+            self._globals["_value"] = float(value)
+        self._globals["_value_returned"] = 0.0 if value is None else 1.0
 
     def exists(self, name: str) -> bool:
         """True if the named parameter ``name`` can be read now."""

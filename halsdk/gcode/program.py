@@ -10,6 +10,7 @@ from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from typing import Any, BinaryIO, Optional, Union
 
+from ._eval import assign, evaluate, make_block
 from ._fast import EMPTY, read_line, run_plain, set_file_lines
 from .block import Block, code_key
 from .errors import GCodeError
@@ -550,7 +551,7 @@ class Program:
 
     # -- evaluation helpers ------------------------------------------------
     def _value(self, expr: Expr, line: Line) -> float:
-        return expr.evaluate(self.params, Where(line.file, line.number))
+        return evaluate(expr, self.params, line.file, line.number)
 
     def _set(self, key: int | str, value: float, line: Line,
              column: int) -> None:
@@ -572,13 +573,17 @@ class Program:
 
     def _block(self, line: Line) -> Block:
         """Evaluate the words of ``line`` and apply its assignments."""
+        return make_block(self, line)
+
+    def _block_python(self, line: Line) -> Block:
+        """:meth:`_block` in Python: the reference of its behaviour."""
         block = Block(line.file, line.number, line.text,
                       block_delete=line.block_delete,
                       line_number=line.line_number)
         params = self.params
-        where = Where(line.file, line.number)
+        file, number = line.file, line.number
         for word in line.words:
-            value = word.value.evaluate(params, where)
+            value = evaluate(word.value, params, file, number)
             if word.letter in "gm":
                 value = round(value, 4)
                 key = code_key(word.letter, value)
@@ -589,7 +594,7 @@ class Program:
                 block.words[word.letter] = value
                 block.columns[word.letter] = word.column
         values = [(self._parameter_key(a.target, line),
-                   a.value.evaluate(params, where), a.column)
+                   evaluate(a.value, params, file, number), a.column)
                   for a in line.assignments]
         for param, value, column in values:
             self._set(param, value, line, column)
@@ -654,6 +659,7 @@ class Program:
         seen_code = False
         clock = self.clock
         structure = unit.structure
+        params = self.params
         while True:
             if interp is None:
                 entry = read_line(unit, index)
@@ -670,7 +676,8 @@ class Program:
                         f"end of file inside {_label(frames[-1].name)}",
                         unit.file, unit.count, 1)
                 return
-            if not frames and structure.sub_starts:
+            if not frames and structure.sub_starts and \
+                    structure.sub_starts[0] <= index <= structure.sub_ends[-1]:
                 end = structure.sub_end(index)
                 if end >= 0:
                     # a subroutine definition met in the main flow: skip it
@@ -709,11 +716,13 @@ class Program:
             oword = line.oword
             if oword is None:
                 index += 1
-                if line.empty:
-                    continue
                 if line.words:
                     seen_code = True
-                block = self._block(line)
+                elif not line.comments:
+                    if line.assignments:
+                        assign(self, line)      # no block to hand out
+                    continue
+                block = make_block(self, line)
                 working = bool(block.g or block.m or block.words
                                or block.message is not None)
                 if working or block.comments:
@@ -723,17 +732,16 @@ class Program:
                         self._idle_since = clock()
                     else:   # the time the consumer held it is not idle
                         self._idle_since += clock() - handed
-                if any(abs(m - 2) < 1e-6 or abs(m - 30) < 1e-6
-                       for m in block.m):
+                if block.m and any(abs(m - 2) < 1e-6 or abs(m - 30) < 1e-6
+                                   for m in block.m):
                     return
                 continue
             seen_code = True
             keyword = oword.keyword
-            frame_key = id(frames[-1]) if frames else 0
 
             if keyword == "call":
                 name = oword.name if isinstance(oword.name, str) else \
-                    f"{self._value(oword.name, line):g}"
+                    f"{evaluate(oword.name, params, line.file, line.number):g}"
                 python = self.python_subs(name) if self.python_subs \
                     else None
                 if python is not None:
@@ -751,12 +759,13 @@ class Program:
                     raise GCodeError("Too many subroutine levels", line.file,
                                      line.number, oword.column)
                 self._count(unit, index, "subroutine call")
-                args = [self._value(a, line) for a in oword.args]
+                args = [evaluate(a, params, line.file, line.number)
+                        for a in oword.args]
                 if len(args) > 30:
                     raise GCodeError("Too many subroutine parameters",
                                      line.file, line.number, oword.column)
-                self.params.set("_value_returned", 0.0)
-                self.params.push_scope(args)
+                params.set_returned(None)
+                params.push_scope(args)
                 frames.append(_Frame(unit, index + 1, name))
                 unit = target
                 structure = unit.structure
@@ -765,17 +774,14 @@ class Program:
                 if keyword == "endsub" and not frames:
                     index += 1
                     continue
-                returned = self._value(oword.args[0], line) \
-                    if oword.args else None
+                returned = evaluate(oword.args[0], params, line.file,
+                                    line.number) if oword.args else None
                 frame = frames.pop()
-                self.params.pop_scope()
-                for key in [k for k in repeats if k[0] == id(frame)]:
-                    del repeats[key]
-                if returned is not None:
-                    self.params.set("_value", returned)
-                    self.params.set("_value_returned", 1.0)
-                else:
-                    self.params.set("_value_returned", 0.0)
+                params.pop_scope()
+                if repeats:
+                    for key in [k for k in repeats if k[0] == id(frame)]:
+                        del repeats[key]
+                params.set_returned(returned)
                 unit, index = frame.return_unit, frame.return_index
                 structure = unit.structure
             elif keyword == "sub":
@@ -789,13 +795,13 @@ class Program:
             elif keyword == "while" and index in structure.loop_start:
                 # the closing "while" of a do loop
                 opener = structure.loop_start[index]
-                if self._value(oword.args[0], line):
+                if evaluate(oword.args[0], params, line.file, line.number):
                     self._count(unit, opener, "loop")
                     index = opener + 1
                 else:
                     index += 1
             elif keyword == "while":
-                if self._value(oword.args[0], line):
+                if evaluate(oword.args[0], params, line.file, line.number):
                     self._count(unit, index, "loop")
                     index += 1
                 else:
@@ -804,8 +810,9 @@ class Program:
                 self._count(unit, index, "loop")
                 index += 1
             elif keyword == "repeat":
-                count = int(self._value(oword.args[0], line))
-                repeats[(frame_key, index)] = count
+                count = int(evaluate(oword.args[0], params, line.file,
+                                     line.number))
+                repeats[(id(frames[-1]) if frames else 0, index)] = count
                 if count <= 0:
                     index = structure.loop_end[index] + 1
                 else:
@@ -813,7 +820,7 @@ class Program:
                     index += 1
             elif keyword == "endrepeat":
                 opener = structure.loop_start[index]
-                key = (frame_key, opener)
+                key = (id(frames[-1]) if frames else 0, opener)
                 repeats[key] -= 1
                 if repeats[key] > 0:
                     self._count(unit, opener, "loop")
@@ -825,7 +832,7 @@ class Program:
                 index = structure.loop_start[index]
             elif keyword == "break":
                 opener = structure.loop_of[index]
-                repeats.pop((frame_key, opener), None)
+                repeats.pop((id(frames[-1]) if frames else 0, opener), None)
                 index = structure.loop_end[opener] + 1
             elif keyword == "continue":
                 opener = structure.loop_of[index]
