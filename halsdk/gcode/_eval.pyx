@@ -400,7 +400,9 @@ cpdef double evaluate(object expr, object params, str file,
     node = compiled(expr)
     try:
         return node.ev(params)
-    except _GiveUp:
+    except (_GiveUp, GCodeError):
+        # the Python tree again: its value, or its error at its place (a
+        # parameter the predefined-name callback refuses, for one)
         return expr.evaluate(params, Where(file, line))
 
 

@@ -205,7 +205,7 @@ def test_program_runs_values_through_the_compiled_evaluator() -> None:
         error = str(exc)
     assert blocks == [{"x": 0.0, "y": 0.0}, {"x": 2.0, "y": 1.0},
                       {"x": 4.0, "y": math.sqrt(2)}, {"x": 0.0}]
-    assert error == "w.ngc:8:7: division by zero"
+    assert error == "w.ngc:8:7: Attempt to divide by zero"
 
 
 ASSIGN_LINE = st.builds(
