@@ -426,13 +426,21 @@ def _teardown(conn: Connection) -> None:
 @atexit.register
 def _close_at_exit() -> None:
     if _conn is not None:
-        # the process is ending: a second Ctrl-C (halrun's unloadusr, an
-        # impatient user) must not cut the teardown short, which would
-        # print a traceback and leave the component half removed
+        # the process is ending: another Ctrl-C or SIGTERM (halrun's
+        # unloadusr, an impatient user; both raise KeyboardInterrupt
+        # here) must not cut the teardown short, which would print a
+        # traceback and leave the component half removed. Once ignored,
+        # a signal that came just before is not raised either.
         import signal
         import threading
         if threading.current_thread() is threading.main_thread():
-            signal.signal(signal.SIGINT, signal.SIG_IGN)
+            for _ in range(3):
+                try:
+                    signal.signal(signal.SIGINT, signal.SIG_IGN)
+                    signal.signal(signal.SIGTERM, signal.SIG_IGN)
+                    break
+                except KeyboardInterrupt:
+                    continue
         _teardown(_conn)
 
 

@@ -375,9 +375,9 @@ def test_component_that_exits_normally_is_not_marked(hal, tmp_path):
 
 def test_a_ctrl_c_during_the_exit_does_not_cut_the_teardown(tmp_path,
                                                            hosts):
-    """A second SIGINT while the process ends (halrun's unloadusr and a
-    user's Ctrl-C together) arrives in the middle of the teardown: the
-    teardown still completes, without a traceback."""
+    """A SIGINT and a SIGTERM while the process ends (halrun's unloadusr
+    and a user's Ctrl-C together) arrive in the middle of the teardown:
+    the teardown still completes, without a traceback."""
     host = hosts.make("ctrlc", "")
     host.up()
     code = textwrap.dedent("""\
@@ -390,7 +390,8 @@ def test_a_ctrl_c_during_the_exit_does_not_cut_the_teardown(tmp_path,
         real = instance._teardown
         def teardown(conn):
             os.kill(os.getpid(), signal.SIGINT)
-            time.sleep(0.2)    # the signal is handled before detach
+            os.kill(os.getpid(), signal.SIGTERM)
+            time.sleep(0.2)    # the signals are handled before detach
             real(conn)
         instance._teardown = teardown
     """)

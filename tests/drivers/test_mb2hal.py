@@ -768,7 +768,7 @@ def test_halrun_single_write_of_several_elements_sends_nothing(
         proc = _halrun(tmp_path, "loadusr -W mb2hal config=plc.ini\n"
                        "setp mb2hal.w6.00.int 11\nsetp mb2hal.w6.01.int 22\n"
                        "setp mb2hal.w5.a.bit 1\nsetp mb2hal.one.00.int 33\n"
-                       "loadusr -w sleep 0.6\n"
+                       "loadusr -w sleep 2\n"
                        "getp mb2hal.w6.num_errors\n"
                        "getp mb2hal.w5.num_errors\n"
                        "getp mb2hal.one.num_errors\n"
