@@ -183,7 +183,7 @@ def test_inch_program_on_a_metric_machine():
     ("G93\nG5.2 X1 Y1 P1 F1\nX2 Y2 P1 F1\nG5.3\n", "inverse time"),
     ("F10\nG5.2 X1 Y1 P0\nX2 Y2 P1\nG5.3\n", "weights P must be above 0"),
     ("F10\nG5.2 X1 Y1 P1 L1\nX2 Y2 P1\nG5.3\n", "at least 2"),
-    ("F10\nG5.2 X1 Y1 P1 L2.5\n", "whole number"),
+    ("F10\nG5.2 X1 Y1 P1 L2.5\n", "Non integer value for integer"),
     ("F10\nG5.2 X1 Y1 P1\nX2 Y2\nG5.3\n", "positive weight P"),
     ("F10\nG5.2 X1 Y1 L2\nX2 Y2 P1\nG5.3\n", "needs its weight P"),
     ("F10\nG5.2 X1 Y1 P1\nG5.3\n", "at least equal to the order L = 3"),

@@ -282,8 +282,8 @@ def test_hal_item_unknown_or_feature_off_is_an_error(hal, tmp_path,
                                                      mcodes):
     hal.newsig("gauge", "float")
     m = build(hal, tmp_path, INI + "HAL_PIN_VARS = 0\n")
-    with pytest.raises(MachineError, match=r"part.ngc:1:6: named "
-                       r"parameter #<_hal\[gauge\]> is not defined"):
+    with pytest.raises(MachineError, match=r"part.ngc:1:6: Named "
+                       r"parameter #<_hal\[gauge\]> not defined"):
         run(m, tmp_path, "#1 = #<_hal[gauge]>\nM2\n")
     m.state(TaskState.ON)
     m.hal_pin_vars = True
