@@ -193,12 +193,13 @@ def parse_remap(text: str, file: str = "", line: int = 0,
     else:
         raise fail(f"{parts[0]} is not a G, M, T, S or F code")
     argspec = options.get("argspec", "")
-    bad = sorted({c for c in argspec
-                  if c not in "@^>" and c.lower() not in _ARGSPEC_LETTERS})
-    if bad or argspec.count("@") > 1:
-        raise fail(f"argspec={argspec}: "
-                   + (f"letters {''.join(bad)} are not allowed" if bad
-                      else "'@' given twice"))
+    bad = [c for c in argspec
+           if c not in "@^>" and c.lower() not in _ARGSPEC_LETTERS]
+    if bad:                             # (the reference's words)
+        raise RemapError(f"argspec: illegal word '{bad[0]}' - "
+                         f"{_quoted(text, line)}", file, line)
+    if argspec.count("@") > 1:
+        raise fail(f"argspec={argspec}: '@' given twice")
     ngc, python = options.get("ngc"), options.get("python")
     if ngc and python:
         raise fail("ngc= and python= exclude each other")

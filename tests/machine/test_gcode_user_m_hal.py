@@ -287,8 +287,8 @@ def test_hal_item_unknown_or_feature_off_is_an_error(hal, tmp_path,
         run(m, tmp_path, "#1 = #<_hal[gauge]>\nM2\n")
     m.state(TaskState.ON)
     m.hal_pin_vars = True
-    with pytest.raises(MachineError, match=r"#<_hal\[nope\]> is not "
-                       "defined"):
+    with pytest.raises(MachineError, match=r"Named parameter "
+                       r"#<_hal\[nope\]> not defined"):
         run(m, tmp_path, "#1 = #<_hal[nope]>\nM2\n")
 
 
