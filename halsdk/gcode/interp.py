@@ -1582,7 +1582,7 @@ class Interpreter:
         if order is not None and order < 0:
             raise block.error("Negative l word used", "l")
         if order is not None and order != int(order):
-            raise block.error("the order L must be a whole number", "l")
+            raise block.error("Non integer value for integer", "l")
         weight = w.get("p")
         if not self.ref:
             self._nurbs_machine_checks(block, key, order, weight,
@@ -2120,9 +2120,10 @@ class Interpreter:
         number = code // 10
         path = self.user_m(number) if self.user_m is not None else None
         if path is None:
-            raise block.error(f"Unknown m code used: M{number} (no "
-                              f"executable file M{number} on the M-code "
-                              "search path)", f"m{number}")
+            # (the reference's words; the M-code search path has no
+            # executable file M<number>)
+            raise block.error(f"Unknown m code used: M{number}",
+                              f"m{number}")
         return path
 
     def _user_m_code(self, block: Block, code: int) -> None:

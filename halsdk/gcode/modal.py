@@ -80,6 +80,11 @@ def _by_group(block: Block, letter: str, values: Iterable[float],
             if code == 800:
                 continue
             del found[1]
+        if group in found and letter == "g" and group == 1 and \
+                53 in (code, found[1]):
+            # G5.3 beside another motion code (the reference's words)
+            raise block.error("Between G5.2 and G5.3 codes, only "
+                              "additional G5.2 codes are allowed.", name)
         if group in found:
             raise block.error(f"Two {letter} codes used from same modal "
                               "group", name)

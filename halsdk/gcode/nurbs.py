@@ -23,6 +23,12 @@ MAX_POINTS = 200_000
 #: bisections of one knot span at most (2**20 chords) and at least
 _MAX_DEPTH = 20
 _MIN_DEPTH = 2
+#: where a piece is sampled (fractions of its parameter range, besides
+#: the middle), and the share of the tolerance the samples may use: the
+#: curve between two samples may stray a little further (with weights,
+#: the farthest point of a piece can be well off its middle)
+_SAMPLES = (0.125, 0.25, 0.375, 0.625, 0.75, 0.875)
+_MARGIN = 0.95
 
 
 def knot_vector(count: int, order: int) -> list[float]:
@@ -88,10 +94,10 @@ def polyline(controls: Sequence[Point], weights: Sequence[float],
     """Points on the curve, from its start (excluded: where the tool is)
     to its end (the last control point), such that each chord stays
     within ``tolerance`` of the curve piece it replaces: every knot span
-    is halved (twice at least) until the curve at a quarter, half and
-    three quarters of each piece lies within the tolerance of its chord
-    and does not turn back against the chord at either end (a turn whose
-    tip the samples could miss)."""
+    is halved (twice at least) until the curve at every eighth of each
+    piece lies within 95% of the tolerance of its chord (the margin is
+    for the curve between the samples) and does not turn back against
+    the chord at either end (a turn whose tip the samples could miss)."""
     if tolerance <= 0:
         raise ValueError("the tolerance must be above 0")
     if any(not w > 0 for w in weights):
@@ -117,9 +123,9 @@ def polyline(controls: Sequence[Point], weights: Sequence[float],
         if depth < _MAX_DEPTH:
             h = (u1 - u0) * 1e-3
             split = depth < _MIN_DEPTH or max(
-                _off_chord(pm, p0, p1),
-                _off_chord(at((u0 + um) / 2), p0, p1),
-                _off_chord(at((um + u1) / 2), p0, p1)) > tolerance or \
+                _off_chord(pm, p0, p1), *(
+                    _off_chord(at(u0 + f * (u1 - u0)), p0, p1)
+                    for f in _SAMPLES)) > tolerance * _MARGIN or \
                 heads_back(u0, h, p0, p1) or heads_back(u1 - h, h, p0, p1)
             if split:
                 piece(u0, p0, um, pm, depth + 1)

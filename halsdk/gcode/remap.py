@@ -27,7 +27,9 @@ procedure, then the rest of the block.
   error message.
 
 A bad ``REMAP`` line is a :class:`RemapError` naming the INI file and
-line.
+line; its message, and the warning for a G or M code with no
+``modalgroup=`` (passed to ``warn``), are the reference's words, which
+quote the line as ``LINE:REMAP = VALUE``.
 """
 
 from __future__ import annotations
@@ -74,6 +76,16 @@ class RemapError(GCodeError):
     cannot run (file: the G-code program)."""
 
 
+#: ``warn(warning)``: a warning about the INI file (a :class:`GCodeError`
+#: that names the file and line, not raised)
+Warn = Callable[[GCodeError], None]
+
+
+def _quoted(text: str, line: int) -> str:
+    """A REMAP line as the reference quotes it in its messages."""
+    return f"{line}:REMAP = {text.strip()}"
+
+
 @dataclass(frozen=True)
 class Remap:
     """One ``REMAP=`` line."""
@@ -88,6 +100,8 @@ class Remap:
     epilog: Optional[str] = None
     file: str = ""
     line: int = 0
+    #: the value of the REMAP line, as written
+    text: str = ""
 
     @property
     def name(self) -> str:
@@ -114,8 +128,10 @@ class Remap:
                        if c.isalpha() and c.lower() != "n")
 
 
-def parse_remap(text: str, file: str = "", line: int = 0) -> Remap:
-    """Read the value of one ``REMAP=`` line."""
+def parse_remap(text: str, file: str = "", line: int = 0,
+                warn: Optional[Warn] = None) -> Remap:
+    """Read the value of one ``REMAP=`` line; ``warn`` receives the
+    reference's warning for a G or M code with no ``modalgroup=``."""
     def fail(message: str) -> RemapError:
         return RemapError(f"REMAP={text.strip()}: {message}", file, line)
 
@@ -128,8 +144,9 @@ def parse_remap(text: str, file: str = "", line: int = 0) -> Remap:
         key, eq, option = part.partition("=")
         key = key.lower()
         if not eq or key not in _OPTIONS:
-            raise fail(f"unknown option {part!r} (known: "
-                       f"{', '.join(o + '=' for o in _OPTIONS if o != 'py')})")
+            # (the reference warns and goes on; we refuse a typo)
+            raise RemapError(f"unrecognized option '{part}' in  "
+                             f"{_quoted(text, line)}", file, line)
         if key == "py":
             key = "python"
         if key in options:
@@ -149,6 +166,11 @@ def parse_remap(text: str, file: str = "", line: int = 0) -> Remap:
             raise fail(f"{parts[0]} is not a G, M, T, S or F code")
         code = code_key(letter, value)
         default = 1 if letter == "g" else 10
+        if "modalgroup" not in options and warn is not None:
+            warn(GCodeError(f"warning: code '{parts[0]}' : no "
+                            "modalgroup=<int> given, using default group "
+                            f"{default} : {_quoted(text, line)}", file,
+                            line))
         try:
             group = int(options.get("modalgroup", default))
         except ValueError:
@@ -171,22 +193,26 @@ def parse_remap(text: str, file: str = "", line: int = 0) -> Remap:
     else:
         raise fail(f"{parts[0]} is not a G, M, T, S or F code")
     argspec = options.get("argspec", "")
-    bad = sorted({c for c in argspec
-                  if c not in "@^>" and c.lower() not in _ARGSPEC_LETTERS})
-    if bad or argspec.count("@") > 1:
-        raise fail(f"argspec={argspec}: "
-                   + (f"letters {''.join(bad)} are not allowed" if bad
-                      else "'@' given twice"))
+    bad = [c for c in argspec
+           if c not in "@^>" and c.lower() not in _ARGSPEC_LETTERS]
+    if bad:                             # (the reference's words)
+        raise RemapError(f"argspec: illegal word '{bad[0]}' - "
+                         f"{_quoted(text, line)}", file, line)
+    if argspec.count("@") > 1:
+        raise fail(f"argspec={argspec}: '@' given twice")
     ngc, python = options.get("ngc"), options.get("python")
     if ngc and python:
         raise fail("ngc= and python= exclude each other")
     if not ngc and not python:
-        raise fail("needs ngc= or python=")
+        raise RemapError(f"code '{parts[0]}' - no remap function given, "
+                         "use either 'python=<function>' or "
+                         f"'ngc=<basename>' : {_quoted(text, line)}",
+                         file, line)
     if python and (options.get("prolog") or options.get("epilog")):
         raise fail("prolog= and epilog= go with ngc=, not python=")
     return Remap(code, group, argspec, ngc or None, python or None,
                  options.get("prolog") or None, options.get("epilog") or None,
-                 file, line)
+                 file, line, text.strip())
 
 
 @dataclass
@@ -210,16 +236,22 @@ class Remapper:
     search_path: tuple[str, ...] = ()
 
     @classmethod
-    def from_ini(cls, ini: Any) -> Remapper:
-        """Read ``[RS274NGC]REMAP`` lines and load ``[PYTHON]TOPLEVEL``."""
+    def from_ini(cls, ini: Any, warn: Optional[Warn] = None) -> Remapper:
+        """Read ``[RS274NGC]REMAP`` lines and load ``[PYTHON]TOPLEVEL``;
+        ``warn`` receives the warnings of the lines (see
+        :func:`parse_remap`)."""
         remapper = cls(plugin=Plugin.from_ini(ini))
         for value, number in ini.every.get(("RS274NGC", "REMAP"), []):
-            remap = parse_remap(value, ini.path, number)
+            # (a code remapped twice is refused before its warnings)
+            warnings: list[GCodeError] = []
+            remap = parse_remap(value, ini.path, number, warnings.append)
             if remap.code in remapper.remaps:
-                first = remapper.remaps[remap.code]
-                raise RemapError(f"REMAP={value}: {remap.name} is remapped "
-                                 f"twice (first at line {first.line})",
+                raise RemapError(f"code '{value.split()[0]}' already "
+                                 f"remapped : {_quoted(value, number)}",
                                  ini.path, number)
+            for warning in warnings:
+                if warn is not None:
+                    warn(warning)
             remapper.remaps[remap.code] = remap
         for remap in remapper.remaps.values():
             for name in (remap.python, remap.prolog, remap.epilog):
@@ -296,14 +328,17 @@ class Remapper:
     def execute(self, interp: Any, block: Block, remap: Remap) -> None:
         """Run ``block`` whose code ``remap`` is remapped: the part before
         it in the order of execution, the procedure, the rest."""
-        words = self._words(interp, block, remap)
         before, after = _split(block, remap)
+        try:
+            words = self._words(interp, block, remap)
+        except GCodeError as exc:
+            raise _as_call(exc, block, remap) from None
         if before is not None:
             interp.execute(before)
         if len(self.active) >= MAX_REMAP_LEVEL:
-            raise block.error(f"remapped codes nested deeper than "
-                              f"{MAX_REMAP_LEVEL} ({remap.name})",
-                              remap.code)
+            # (deeper than MAX_REMAP_LEVEL, the reference's words)
+            raise block.error("maximum nesting of remapped blocks "
+                              "exceeded", remap.code)
         interp.line = block.line
         interp.line_block = block
         self.active.append(_Active(remap, block))
@@ -318,6 +353,8 @@ class Remapper:
                     _close_scopes(interp.params, depth)
             else:
                 self._ngc(interp, block, remap, words)
+        except GCodeError as exc:
+            raise _as_call(exc, block, remap) from None
         finally:
             self.active.pop()
         if after is not None:
@@ -328,18 +365,16 @@ class Remapper:
         """The argspec words of ``block``, checked."""
         spec = remap.argspec
         missing = [c for c in remap.required if c not in block.words]
-        if missing:
-            raise block.error(f"user-defined {remap.name}: missing: "
-                              f"{','.join(c.upper() for c in missing)}",
-                              remap.code)
-        problems = []
+        # the reference's words: the words missing, then F>0, (a feed
+        # above 0 needed) and S>0, (a spindle speed above 0)
+        problem = (f" missing: {','.join(c.upper() for c in missing)}"
+                   if missing else "")
         if ">" in spec and not interp.feed_value > 0:
-            problems.append("a feed above 0 (F)")
+            problem += "F>0,"
         if "^" in spec and not interp.speed > 0:
-            problems.append("a spindle speed above 0 (S)")
-        if problems:
-            raise block.error(f"user-defined {remap.name} needs "
-                              f"{' and '.join(problems)}",
+            problem += "S>0,"
+        if problem:
+            raise block.error(f"user-defined {remap.name}:{problem}",
                               remap.code)
         words = {c: float(block.words[c]) for c in remap.words
                  if c in block.words}
@@ -418,6 +453,17 @@ class Remapper:
         assert remap.ngc is not None
         call_procedure(interp, remap.ngc, block, remap.code,
                        prolog, epilog)
+
+
+def _as_call(exc: GCodeError, block: Block, remap: Remap) -> GCodeError:
+    """An error of the remapped code of ``block`` itself (its words, its
+    Python procedure) shows the line the reference shows for it, the
+    call of the procedure (``O <m400> call ``); errors inside the
+    procedure keep their own line."""
+    if exc.file == block.file and exc.line == block.line and \
+            exc.source is None:
+        exc.source = f"O <{remap.ngc or remap.python}> call "
+    return exc
 
 
 def _check_result(result: Any, what: str, block: Block, key: str) -> None:
@@ -598,20 +644,24 @@ def call_procedure(interp: Any, name: str, block: Block, key: str,
         _close_scopes(params, depth)
 
 
-def configure(interp: Any, ini: Any, search_path: Sequence[str] = ()
-              ) -> Optional[Remapper]:
+def configure(interp: Any, ini: Any, search_path: Sequence[str] = (),
+              warn: Optional[Warn] = None) -> Optional[Remapper]:
     """Give ``interp`` the remapped codes and the Python plugin of the
     :class:`~halsdk.ini.IniFile` ``ini`` (None when it has neither); the
-    ``ngc=`` procedures must be files on ``search_path``."""
-    remapper = Remapper.from_ini(ini)
+    ``ngc=`` procedures must be files on ``search_path``.  ``warn``
+    receives the warnings about the REMAP lines (the reference prints
+    them; default: none)."""
+    remapper = Remapper.from_ini(ini, warn)
     remapper.search_path = tuple(search_path)
     for remap in remapper.remaps.values():
         if remap.ngc is not None and not any(
                 os.path.isfile(os.path.join(d, remap.ngc + ".ngc"))
                 for d in search_path):
-            raise RemapError(f"REMAP {remap.name}: ngc={remap.ngc}: no file "
-                             f"{remap.ngc}.ngc on the subroutine path "
-                             f"({os.pathsep.join(search_path) or 'empty'})",
+            # (the reference's two lines; the path searched was
+            # search_path)
+            raise RemapError(f"INTERP_REMAP: NGC file not found: "
+                             f"ngc={remap.ngc}\nREMAP INI Line:"
+                             f"{remap.line} = {remap.text}",
                              remap.file, remap.line)
     if not remapper.remaps and remapper.plugin is None:
         interp.remap = None
@@ -648,8 +698,9 @@ def python_sub(interp: Any, name: str
             raise python_failure(exc, what, file, line, column) from None
         if result is None:
             return None
-        if isinstance(result, str):
-            raise GCodeError(result, file, line, column)
+        if isinstance(result, str):     # (the reference's words)
+            raise GCodeError(f"pycall(oword.{name}) failed", file, line,
+                             column)
         if isinstance(result, (int, float)) and not isinstance(result, bool):
             return float(result)
         raise GCodeError(f"{what} returned {type(result).__name__}: it "

@@ -95,6 +95,8 @@ def _finished_with_percent(text: str) -> bool:
 
 def _source_line(text: str, file: str, exc: GCodeError) -> Optional[str]:
     """The line an error is about (in the program or a subroutine file)."""
+    if exc.source is not None:
+        return exc.source
     if exc.file != file:
         try:
             with open(exc.file, encoding="utf-8") as f:
@@ -149,9 +151,13 @@ def run(text: str, file: str, write: Callable[[str], Any],
     canon.interp = interp
     if ini_file is not None:
         from .remap import configure
+
+        def warn(warning: GCodeError) -> None:
+            error(f"{warning}\n")
+
         try:
-            configure(interp, ini_file, search_path)
-        except GCodeError as exc:       # (the reference prints nothing)
+            configure(interp, ini_file, search_path, warn)
+        except GCodeError as exc:       # (no line of the program)
             error(f"{exc}\n")
             return 1
     canon.start()

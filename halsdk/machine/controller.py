@@ -264,8 +264,11 @@ class TaskController:
         # REMAP= lines and the [PYTHON] plugin (halsdk.gcode.remap): kept
         # for the interpreters made after a reset
         try:
-            self._remap = configure_remap(self.interp, ini,
-                                          self.subroutine_path)
+            # its warnings (a code with no modalgroup=) go to the
+            # operator, as the reference's text messages
+            self._remap = configure_remap(
+                self.interp, ini, self.subroutine_path,
+                lambda warning: self.post(OPERATOR_TEXT, str(warning)))
         except GCodeError as exc:
             raise MachineError(str(exc)) from None
         self.user_m_path = search_path(folder,

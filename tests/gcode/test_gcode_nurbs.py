@@ -69,12 +69,15 @@ def curve(ctrl, weights, order, u):
 
 def distance_to_curve(p, ctrl, weights, order, samples=200):
     """Closest distance of p to the curve: a dense search, then a
-    ternary refinement around each of the best samples (a sharp turn
-    may put two pieces of the curve near p)."""
-    dist = [(math.dist(p, curve(ctrl, weights, order, j / samples)), j)
+    ternary refinement around each local minimum of the samples (a loop
+    or a sharp turn may put other pieces of the curve nearer p than the
+    samples beside it, where the curve moves fast)."""
+    dist = [math.dist(p, curve(ctrl, weights, order, j / samples))
             for j in range(samples + 1)]
     best = math.inf
-    for d, j in sorted(dist)[:4]:
+    for j, d in enumerate(dist):
+        if d > min(dist[max(0, j - 1):j + 2]):
+            continue                    # not a local minimum
         best = min(best, d)
         lo, hi = max(0.0, (j - 1) / samples), min(1.0, (j + 1) / samples)
         for _ in range(50):
@@ -135,11 +138,12 @@ def test_feeds_lie_on_the_curve_within_the_tolerance(case):
     # every point (a dozen of them, spread) is on the curve
     for p in points[::max(1, len(points) // 12)]:
         assert distance_to_curve(p, ctrl, weights, order) < 1e-6
-    # and the curve never strays from the chords by more than 1 um
+    # and the curve never strays from the chords by more than 1 um (a
+    # weighted piece may have its farthest point well off its middle)
     path = [tuple(ctrl[0])] + points
     for j in range(151):
         q = curve(ctrl, weights, order, j / 150)
-        assert distance_to_polyline(q, path) <= TOL_MM * 1.05
+        assert distance_to_polyline(q, path) <= TOL_MM
 
 
 def test_the_manual_example_and_the_position_after_it():
@@ -183,7 +187,7 @@ def test_inch_program_on_a_metric_machine():
     ("G93\nG5.2 X1 Y1 P1 F1\nX2 Y2 P1 F1\nG5.3\n", "inverse time"),
     ("F10\nG5.2 X1 Y1 P0\nX2 Y2 P1\nG5.3\n", "weights P must be above 0"),
     ("F10\nG5.2 X1 Y1 P1 L1\nX2 Y2 P1\nG5.3\n", "at least 2"),
-    ("F10\nG5.2 X1 Y1 P1 L2.5\n", "whole number"),
+    ("F10\nG5.2 X1 Y1 P1 L2.5\n", "Non integer value for integer"),
     ("F10\nG5.2 X1 Y1 P1\nX2 Y2\nG5.3\n", "positive weight P"),
     ("F10\nG5.2 X1 Y1 L2\nX2 Y2 P1\nG5.3\n", "needs its weight P"),
     ("F10\nG5.2 X1 Y1 P1\nG5.3\n", "at least equal to the order L = 3"),

@@ -282,13 +282,13 @@ def test_hal_item_unknown_or_feature_off_is_an_error(hal, tmp_path,
                                                      mcodes):
     hal.newsig("gauge", "float")
     m = build(hal, tmp_path, INI + "HAL_PIN_VARS = 0\n")
-    with pytest.raises(MachineError, match=r"part.ngc:1:6: named "
-                       r"parameter #<_hal\[gauge\]> is not defined"):
+    with pytest.raises(MachineError, match=r"part.ngc:1:6: Named "
+                       r"parameter #<_hal\[gauge\]> not defined"):
         run(m, tmp_path, "#1 = #<_hal[gauge]>\nM2\n")
     m.state(TaskState.ON)
     m.hal_pin_vars = True
-    with pytest.raises(MachineError, match=r"#<_hal\[nope\]> is not "
-                       "defined"):
+    with pytest.raises(MachineError, match=r"Named parameter "
+                       r"#<_hal\[nope\]> not defined"):
         run(m, tmp_path, "#1 = #<_hal[nope]>\nM2\n")
 
 

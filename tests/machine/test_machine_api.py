@@ -520,6 +520,21 @@ def test_remapped_codes_of_the_ini_run_on_the_machine(machine, tmp_path):
         m.mdi("M401")                   # Z is required
 
 
+def test_a_remap_warning_is_an_operator_text_message(machine, tmp_path):
+    """A REMAP code with no modalgroup=: the reference's warning, posted
+    to the operator as a text message (the code still works)."""
+    from halsdk.ini import IniFile
+    (tmp_path / "m400.ngc").write_text("o<m400> sub\no<m400> endsub\n")
+    ini = tmp_path / "warn.ini"
+    ini.write_text("[RS274NGC]\nSUBROUTINE_PATH = .\n"
+                   "REMAP=M400 ngc=m400\n")
+    machine.errors()
+    machine.configure_from_ini(IniFile(str(ini)))
+    assert ("text", f"{ini}:3:0: warning: code 'M400' : no "
+                    "modalgroup=<int> given, using default group 10 : "
+                    "3:REMAP = M400 ngc=m400") in machine.errors()
+
+
 def test_a_bad_remap_line_names_the_ini_line(machine, tmp_path):
     from halsdk.ini import IniFile
     ini = tmp_path / "bad.ini"
