@@ -140,7 +140,9 @@ def test_the_machine_waits_for_the_m_code(hal, tmp_path, mcodes):
 
 def test_mdi_m_code_and_the_exec_state_while_it_runs(hal, tmp_path, mcodes):
     from halsdk.channels.constants import EXEC_DONE, EXEC_WAITING_FOR_SYSTEM_CMD
-    executable(mcodes / "M105", '#!/bin/sh\necho "$1 $2" > args\n'
+    # (written whole, then renamed: the test polls for the file)
+    executable(mcodes / "M105", '#!/bin/sh\necho "$1 $2" > args.tmp\n'
+               'mv args.tmp args\n'
                'while [ ! -e go ]; do sleep 0.05; done\n')
     m = build(hal, tmp_path, INI)
     m.mode(TaskMode.MDI)
