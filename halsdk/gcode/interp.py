@@ -315,17 +315,25 @@ class Interpreter:
         if self.ref:
             self._emit(C.Trace(text, kind, self.line))
 
+    def _last_comment(self, block: Block) -> Optional[tuple[str, str]]:
+        """The last comment of the line as :func:`last_comment` gives it;
+        None when there is none or when it was Python code (a ``;py,``
+        line, a ``(py,...)`` comment), which this runs."""
+        if self._py_line(block):
+            return None
+        found = last_comment(block.text)
+        if found is not None and found[0] == "py":
+            self._py_comment(found[1], block)
+            return None
+        return found
+
     def _comment_trace(self, block: Block) -> None:
         """The last comment of the line, as the reference reports it."""
-        if self._py_line(block):
-            return
-        found = last_comment(block.text)
+        found = self._last_comment(block)
         if found is None:
             return
         kind, text = found
-        if kind == "py":
-            self._py_comment(text, block)
-        elif kind == "":
+        if kind == "":
             self._trace(f'COMMENT("{text}")')
         elif kind == "msg":
             self._trace(f'MESSAGE("{text}")')
@@ -345,16 +353,12 @@ class Interpreter:
         :func:`last_comment` and :func:`probe_comment`): LOG* and PROBE*
         canon commands, which the machine's executor carries out; and the
         Python comments (:meth:`_py_comment`)."""
-        if self._py_line(block):
-            return
-        found = last_comment(block.text)
+        found = self._last_comment(block)
         if found is None:
             return
         kind, text = found
         line = self.line
-        if kind == "py":
-            self._py_comment(text, block)
-        elif kind == "log":
+        if kind == "log":
             self._emit(C.Log(self._substitute(text), line))
         elif kind in ("logopen", "logappend"):
             self._emit(C.LogOpen(text, kind == "logappend", line))
