@@ -521,11 +521,13 @@ def fast_move(object interp, object block):
     line = block.line
     interp.line = line
     interp.line_block = block
-    if modal.feed_mode == 940:
-        f = words.get("f")
-        if f is not None:
-            if f < 0:
-                raise block.error("Negative f word used", "f")
+    f = words.get("f")
+    if f is not None:
+        # Interpreter._execute's F word (not the reference's calls)
+        if f < 0:
+            raise block.error("Negative f word used", "f")
+        interp.feed_value = f
+        if modal.feed_mode == 940:
             interp.feed = interp._len(f)
             interp._emit(_SetFeedRate(interp.feed, line))
     if explicit is not None:
