@@ -747,6 +747,15 @@ def run_plain(object unit, Py_ssize_t index, object interp,
     """
     cdef dict kept = unit._kept
     cdef dict owords = unit.owords
+    cdef object entry = kept.get(index) if kept else None
+    # an o-word or another kept line that is not plain (most lines of a
+    # loop or a subroutine): handed back before the state is looked at
+    if entry is None:
+        entry = owords.get(index)
+        if entry is not None:
+            return index, entry, False
+    elif type(entry) is not tuple:
+        return index, entry, False
     cdef object source = unit.source
     cdef object structure = unit.structure
     cdef list sub_starts = structure.sub_starts
@@ -762,7 +771,7 @@ def run_plain(object unit, Py_ssize_t index, object interp,
     cdef Machine m
     cdef const char *s
     cdef Py_ssize_t n
-    cdef object raw, text, entry, modal = None, emit = None, line
+    cdef object raw, text, modal = None, emit = None, line
     cdef object motion_now, explicit, plane_code = None
     cdef list pos, end
     cdef double prog[9]
