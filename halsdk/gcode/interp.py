@@ -2155,6 +2155,9 @@ class Interpreter:
             return None
 
     def _predefined(self, name: str) -> Optional[float]:
+        if name in _NOT_PREDEFINED and self.remap is None:
+            return None         # a global name of the program's own
+        asked = name
         name = name.strip("<>").lower()
         if name.startswith("_ini[") and "]" in name:
             return self._ini_value(name)
@@ -2180,7 +2183,16 @@ class Interpreter:
             i = AXES.index(name[5])     # machine coordinates, program units
             return self.pos[i] / self._k(i)
         value = _PREDEFINED.get(name)
-        return None if value is None else value(self, self.modal)
+        if value is None:
+            if self.remap is None and len(_NOT_PREDEFINED) < 10_000:
+                _NOT_PREDEFINED.add(asked)
+            return None
+        return value(self, self.modal)
+
+
+#: Names that :meth:`Interpreter._predefined` found no value for, without
+#: a remap (an answer that depends on the name only): answered at once.
+_NOT_PREDEFINED: set[str] = set()
 
 
 #: The read-only predefined named parameters: name -> its value, from the

@@ -381,3 +381,22 @@ def test_numbers_are_read_as_float_reads_them(sign: str, whole: str,
     value = read[1][0][1]
     assert value == float(text)
     assert str(value) == str(float(text))       # -0.0 too
+
+
+def test_names_that_are_not_predefined_stay_so() -> None:
+    # the interpreter remembers the global names it has no value for
+    # (the program's own, such as #<_depth>); predefined ones are still
+    # answered, with their current value
+    params = Parameters()
+    interp = Interpreter(params, None, RecordingCanon())
+    interp.run(Program("G21 G90 F100\n#<_depth> = -0.5\nG0 X2\n", "s.ngc",
+                       params))
+    for _ in range(2):
+        assert interp._predefined("_depth") is None
+        assert interp._predefined("_x") == 2.0
+        assert interp._predefined("_feed") == 100.0
+        assert params.get("_depth") == -0.5
+    interp.run(Program("G0 X3\nF200\n", "t.ngc", params))
+    assert interp._predefined("_x") == 3.0
+    assert interp._predefined("_feed") == 200.0
+    assert interp._predefined("_depth") is None
