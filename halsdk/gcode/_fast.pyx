@@ -639,7 +639,7 @@ from .cutter_radius import CutterComp
 cdef object _CutterComp = CutterComp
 cdef str _DICT = "__dict__"
 #: the letters a plain move may have: axes, centre words, R, P (a bit per
-#: letter); F is for the general path (the feed's bookkeeping)
+#: letter); F is for fast_move (the feed's bookkeeping)
 cdef unsigned int _AXIS_BITS = 0
 cdef unsigned int _ARC_BITS = 0
 for _c in "xyzabcuvw":
