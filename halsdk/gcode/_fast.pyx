@@ -521,11 +521,13 @@ def fast_move(object interp, object block):
     line = block.line
     interp.line = line
     interp.line_block = block
-    if modal.feed_mode == 940:
-        f = words.get("f")
-        if f is not None:
-            if f < 0:
-                raise block.error("Negative f word used", "f")
+    f = words.get("f")
+    if f is not None:
+        # Interpreter._execute's F word (not the reference's calls)
+        if f < 0:
+            raise block.error("Negative f word used", "f")
+        interp.feed_value = f
+        if modal.feed_mode == 940:
             interp.feed = interp._len(f)
             interp._emit(_SetFeedRate(interp.feed, line))
     if explicit is not None:
@@ -637,7 +639,7 @@ from .cutter_radius import CutterComp
 cdef object _CutterComp = CutterComp
 cdef str _DICT = "__dict__"
 #: the letters a plain move may have: axes, centre words, R, P (a bit per
-#: letter); F is for the general path (the feed's bookkeeping)
+#: letter); F is for fast_move (the feed's bookkeeping)
 cdef unsigned int _AXIS_BITS = 0
 cdef unsigned int _ARC_BITS = 0
 for _c in "xyzabcuvw":
@@ -745,6 +747,15 @@ def run_plain(object unit, Py_ssize_t index, object interp,
     """
     cdef dict kept = unit._kept
     cdef dict owords = unit.owords
+    cdef object entry = kept.get(index) if kept else None
+    # an o-word or another kept line that is not plain (most lines of a
+    # loop or a subroutine): handed back before the state is looked at
+    if entry is None:
+        entry = owords.get(index)
+        if entry is not None:
+            return index, entry, False
+    elif type(entry) is not tuple:
+        return index, entry, False
     cdef object source = unit.source
     cdef object structure = unit.structure
     cdef list sub_starts = structure.sub_starts
@@ -760,7 +771,7 @@ def run_plain(object unit, Py_ssize_t index, object interp,
     cdef Machine m
     cdef const char *s
     cdef Py_ssize_t n
-    cdef object raw, text, entry, modal = None, emit = None, line
+    cdef object raw, text, modal = None, emit = None, line
     cdef object motion_now, explicit, plane_code = None
     cdef list pos, end
     cdef double prog[9]

@@ -431,6 +431,14 @@ class Interpreter:
             if remap is not None:       # REMAP= code (halsdk.gcode.remap)
                 self.remap.execute(self, block, remap)
                 return
+        if not (block.g or block.m or block.words) and not self.ref \
+                and block.message is None and not self._autosaved:
+            # comments alone (in a subroutine's body, every call): only a
+            # LOG, PROBEOPEN or py comment does something
+            self.line = block.line
+            self.line_block = block
+            self._comment_canon(block)
+            return
         if self._fast_ready(block) and fast_move(self, block):
             return
         self._execute(block)
@@ -438,12 +446,11 @@ class Interpreter:
     def _fast_ready(self, block: Block) -> bool:
         """Whether the state lets the short path take ``block``: it knows
         neither G7 diameters, nor a rotated coordinate system, nor the
-        M73 restore, nor the feed's bookkeeping (an F word: rare on the
-        lines of a CAM program), nor an arc's turns (a P word, checked
-        before the line runs), nor the reference's extra calls of
-        ``rs274``."""
-        if self.diameter_mode or self._autosaved or "f" in block.words \
-                or "p" in block.words:
+        M73 restore, nor an arc's turns (a P word, checked before the
+        line runs), nor the reference's extra calls of ``rs274`` (its
+        feed calls among them)."""
+        if self.diameter_mode or self._autosaved or "p" in block.words \
+                or "f" in block.words and self.ref:
             return False
         if self.ref and (block.comments or self.modal.feed_mode == 930
                          or AXIS_SET.isdisjoint(block.words)):
@@ -2153,6 +2160,9 @@ class Interpreter:
             return None
 
     def _predefined(self, name: str) -> Optional[float]:
+        if name in _NOT_PREDEFINED and self.remap is None:
+            return None         # a global name of the program's own
+        asked = name
         name = name.strip("<>").lower()
         if name.startswith("_ini[") and "]" in name:
             return self._ini_value(name)
@@ -2178,7 +2188,16 @@ class Interpreter:
             i = AXES.index(name[5])     # machine coordinates, program units
             return self.pos[i] / self._k(i)
         value = _PREDEFINED.get(name)
-        return None if value is None else value(self, self.modal)
+        if value is None:
+            if self.remap is None and len(_NOT_PREDEFINED) < 10_000:
+                _NOT_PREDEFINED.add(asked)
+            return None
+        return value(self, self.modal)
+
+
+#: Names that :meth:`Interpreter._predefined` found no value for, without
+#: a remap (an answer that depends on the name only): answered at once.
+_NOT_PREDEFINED: set[str] = set()
 
 
 #: The read-only predefined named parameters: name -> its value, from the

@@ -96,11 +96,62 @@ def test_fast_path_takes_plain_moves() -> None:
     interp = Interpreter(params, None, RecordingCanon())
     interp.run(Program("G21 G90 F100\n", "s.ngc", params))
     for text, taken in [("G2 X2 Y0 I1", True), ("G1 X1 Y2", True),
-                        ("X3", True), ("G0 Z1", True), ("G1 X1 M3", False),
+                        ("X3", True), ("G0 Z1", True), ("G1 X1 F20", True),
+                        ("F30", True), ("G1 X1 M3", False),
                         ("G1 X1 S100", False), ("G90 G1 X1", False),
                         ("(MSG, hi)", False), ("G4 P1", False)]:
         block = next(Program(text, "m.ngc", Parameters()).blocks())
         assert _fast.fast_move(interp, block) is taken, text
+
+
+def test_f_words_and_comments_take_the_short_path(monkeypatch) -> None:
+    # a move with an F word (units per minute) and a line of comments
+    # alone do not go the general way (the reference's calls aside)
+    params = Parameters()
+    canon = RecordingCanon()
+    interp = Interpreter(params, None, canon)
+    interp.run(Program("G21 G90 F100\n", "s.ngc", params))
+
+    def general(block) -> None:
+        raise AssertionError(f"general path: {block.text}")
+
+    monkeypatch.setattr(interp, "_execute", general)
+    for text in ["G1 X1 F200", "F300", "G0 Y2 F50", "(a comment)",
+                 "(PROBEOPEN probe.txt)"]:
+        interp.execute(next(Program(text, "m.ngc", Parameters()).blocks()))
+    assert interp.feed_value == 50.0 and interp.feed == 50.0
+    assert [type(c).__name__ for c in canon.commands[-5:]] == [
+        "SetFeedRate", "StraightFeed", "SetFeedRate", "SetFeedRate",
+        "StraightTraverse", "ProbeOpen"][-5:]
+
+
+COMMENT = st.sampled_from([
+    "(a comment)", "(PROBEOPEN probe.txt)", "(PROBECLOSE)", "(LOG,x #1)",
+    "(LOGOPEN,log.txt)", "(LOGAPPEND,log.txt)", "(logclose)",
+    "(MSG, hello)", "(debug, #1 is)", "(print,p #<_x>)", "(a) (b)",
+    "N10 (numbered)", "(#1 = x, #2 = y)", "; only this", "(msg ,no)"])
+
+
+@settings(max_examples=150, deadline=None)
+@given(SETUP, COMMENT, st.booleans())
+def test_comments_take_the_general_path_s_way(setup: list[str],
+                                              text: str,
+                                              ref: bool) -> None:
+    params = Parameters()
+    canon = canon_of(ref)
+    fast = Interpreter(params, None, canon)
+    try:
+        fast.run(Program("\n".join(setup) + "\n", "s.ngc", params))
+    except GCodeError:
+        return
+    general = copy.deepcopy(fast)
+    blocks = list(Program(text + "\n", "m.ngc", Parameters()).blocks())
+    if not blocks:
+        return
+    block = blocks[0]
+    assert outcome(fast.execute, block) == \
+        outcome(general._execute, block)
+    assert state(fast, fast.canon) == state(general, general.canon)
 
 
 def test_fast_path_constants_are_the_interpreter_s() -> None:
@@ -224,6 +275,8 @@ ARC = st.tuples(st.sampled_from(["G2", "G3", ""]), number, number,
 OTHER = st.sampled_from(SETUP_LINES + [
     "", "   ", "N10", "(only a comment)", "G1 X1 F300", "M3 S1000",
     "G1 X1 (with a comment)", "#1 = 2", "G1 X#1", "/G1 X9", "G0 X1 Y1 ; c",
+    "(PROBEOPEN p.txt)", "(PROBECLOSE)", "(LOG,at #1)", "G0 X2 F-1",
+    "F250", "G1 Y3 F[100 + 20]", "G0 Z1 F10",
     "(MSG, hello)", "G91 G91.1 F100", "G90 G90.1", "G18", "G19", "G17",
     "G2 X1 R1", "G20", "G21", "G55", "G54", "T1 M6", "G43 H1", "M5",
     "G1 X(é)1", "G10 L20 P1 X0 Y0", "G92 Z-3", "G53 G0 X1"])
@@ -328,3 +381,22 @@ def test_numbers_are_read_as_float_reads_them(sign: str, whole: str,
     value = read[1][0][1]
     assert value == float(text)
     assert str(value) == str(float(text))       # -0.0 too
+
+
+def test_names_that_are_not_predefined_stay_so() -> None:
+    # the interpreter remembers the global names it has no value for
+    # (the program's own, such as #<_depth>); predefined ones are still
+    # answered, with their current value
+    params = Parameters()
+    interp = Interpreter(params, None, RecordingCanon())
+    interp.run(Program("G21 G90 F100\n#<_depth> = -0.5\nG0 X2\n", "s.ngc",
+                       params))
+    for _ in range(2):
+        assert interp._predefined("_depth") is None
+        assert interp._predefined("_x") == 2.0
+        assert interp._predefined("_feed") == 100.0
+        assert params.get("_depth") == -0.5
+    interp.run(Program("G0 X3\nF200\n", "t.ngc", params))
+    assert interp._predefined("_x") == 3.0
+    assert interp._predefined("_feed") == 200.0
+    assert interp._predefined("_depth") is None
