@@ -67,27 +67,28 @@ def curve(ctrl, weights, order, u):
             sum(b[i] * ctrl[i][1] for i in range(n)) / total)
 
 
-def distance_to_curve(p, ctrl, weights, order, samples=200):
-    """Closest distance of p to the curve: a dense search, then a
-    ternary refinement around each local minimum of the samples (a loop
+def distance_to_curve(p, ctrl, weights, order, samples=1000):
+    """Closest distance of p to the curve: a dense search, then, around
+    each local minimum of the samples, a search that samples its bracket
+    densely again and narrows it to the best sample's neighbours (a loop
     or a sharp turn may put other pieces of the curve nearer p than the
-    samples beside it, where the curve moves fast)."""
-    dist = [math.dist(p, curve(ctrl, weights, order, j / samples))
-            for j in range(samples + 1)]
+    samples beside it, where the curve moves fast; the distance need not
+    have one minimum in a bracket, so no ternary search)."""
+    def dist(u):
+        return math.dist(p, curve(ctrl, weights, order, u))
+
+    near = [dist(j / samples) for j in range(samples + 1)]
     best = math.inf
-    for j, d in enumerate(dist):
-        if d > min(dist[max(0, j - 1):j + 2]):
+    for j, d in enumerate(near):
+        if d > min(near[max(0, j - 1):j + 2]):
             continue                    # not a local minimum
-        best = min(best, d)
         lo, hi = max(0.0, (j - 1) / samples), min(1.0, (j + 1) / samples)
-        for _ in range(50):
-            a, b = lo + (hi - lo) / 3, hi - (hi - lo) / 3
-            if math.dist(p, curve(ctrl, weights, order, a)) < \
-                    math.dist(p, curve(ctrl, weights, order, b)):
-                hi = b
-            else:
-                lo = a
-        best = min(best, math.dist(p, curve(ctrl, weights, order, lo)))
+        for _ in range(12):
+            us = [lo + (hi - lo) * k / 20 for k in range(21)]
+            ds = [dist(u) for u in us]
+            k = ds.index(min(ds))
+            best = min(best, ds[k])
+            lo, hi = us[max(0, k - 1)], us[min(20, k + 1)]
     return best
 
 
