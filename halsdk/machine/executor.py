@@ -426,6 +426,12 @@ class Executor(C.Canon):
         text = " ".join(f"{v:f}" for v in point)
         self._write("PROBEOPEN", self._probe_log, text + "\n")
 
+    def shutdown(self) -> None:
+        """The machine stops: end a running user M-code, close the
+        LOGOPEN and PROBEOPEN files."""
+        self.clear()
+        self.close_files()
+
     def close_files(self) -> None:
         """Close the LOGOPEN and PROBEOPEN files (the machine stops)."""
         self._close_log()

@@ -154,7 +154,7 @@ class TaskRunner:
             self.server.close()
         finally:
             self.status.close()
-            self.ctl.executor.close_files()
+            self.ctl.executor.shutdown()
             try:
                 self.ctl.save_parameters()
             except (OSError, HalError) as e:

@@ -21,6 +21,8 @@ import subprocess
 import time
 from typing import Callable, Optional
 
+from halsdk.hal import ends_with_this_process
+
 __all__ = ["DEFAULT_TIMEOUT", "UserMError", "UserMRun", "find_user_m",
            "search_path"]
 
@@ -75,7 +77,10 @@ class UserMRun:
             self.process = subprocess.Popen(
                 self.argv, stdin=subprocess.DEVNULL,
                 cwd=os.path.dirname(path) or None,
-                start_new_session=True)     # its own group, killed whole
+                start_new_session=True,     # its own group, killed whole
+                # and SIGTERM when the machine's task thread ends, however
+                # it ends: a dead machine leaves no M-code running
+                preexec_fn=ends_with_this_process())
         except OSError as e:
             raise UserMError(f"M{code}: cannot run {path}: "
                              f"{e.strerror or e}") from None

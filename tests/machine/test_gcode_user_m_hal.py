@@ -6,6 +6,7 @@ while it runs."""
 from __future__ import annotations
 
 import os
+import signal
 import stat
 import time
 from pathlib import Path
@@ -315,3 +316,20 @@ def test_a_nurbs_block_moves_the_machine_along_the_curve(hal, tmp_path):
     assert max(y for _, y in xs) == pytest.approx(
         max(y for _, y in curve), abs=0.01)
     assert [e for e in m.errors() if e[0] == "error"] == []
+
+
+def test_a_user_m_code_ends_with_the_thread_that_started_it(tmp_path):
+    """A machine that dies (its task thread ends, however) leaves no
+    M-code running: the kernel sends it SIGTERM."""
+    import threading
+    script = executable(tmp_path / "M150", "#!/bin/sh\nexec sleep 30\n")
+    runs: list[UserMRun] = []
+    thread = threading.Thread(
+        target=lambda: runs.append(UserMRun(150, str(script), 0, 0)))
+    thread.start()
+    thread.join()
+    process = runs[0].process
+    try:
+        assert process.wait(timeout=10) == -signal.SIGTERM
+    finally:
+        runs[0].kill()
