@@ -29,7 +29,7 @@ import tempfile
 from halsdk.gcode.rs274 import run
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from regenerate import DEFAULT_REFERENCE  # noqa: E402
+from regenerate import DEFAULT_REFERENCE, run_reference  # noqa: E402
 
 CODES = ["G0", "G1", "G2", "G3", "G17", "G18", "G19", "G20", "G21", "G90",
          "G91", "G54", "G55", "G92", "G92.1", "G28", "G81", "G83", "G80",
@@ -71,9 +71,12 @@ def main() -> int:
                 f.write(text)
             os.chmod(path, 0o644)
             try:
-                ref = subprocess.run([a.reference, "rs274", "-g", "p.ngc"],
-                                     cwd=tmp, capture_output=True,
-                                     text=True, timeout=20)
+                done = run_reference([a.reference, "rs274", "-g",
+                                      "p.ngc"], tmp, 20)
+                ref = subprocess.CompletedProcess(
+                    done.args, done.returncode,
+                    done.stdout.decode("utf-8", "replace"),
+                    done.stderr.decode("utf-8", "replace"))
             except subprocess.TimeoutExpired:
                 print(f"{n}: the reference timed out")
                 continue

@@ -31,8 +31,10 @@ by hand, never by the test suite.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
@@ -44,6 +46,23 @@ HERE = Path(__file__).resolve().parent
 DEFAULT_REFERENCE = os.environ.get(
     "HALSDK_REFERENCE_TOOL",
     str(HERE.parents[2].parent / "shared" / "tools" / "reference"))
+
+
+def run_reference(args: list[str], cwd: str, timeout: float
+                  ) -> subprocess.CompletedProcess[bytes]:
+    """Run the reference tool in a session of its own; past ``timeout``
+    kill the whole session (the tool runs ``rs274`` as another user, so
+    killing the tool alone would leave a runaway ``rs274`` spinning)."""
+    proc = subprocess.Popen(args, cwd=cwd, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, start_new_session=True)
+    try:
+        out, err = proc.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        with contextlib.suppress(OSError):
+            os.killpg(proc.pid, signal.SIGKILL)
+        proc.communicate()
+        raise
+    return subprocess.CompletedProcess(args, proc.returncode, out, err)
 
 
 def is_library(path: Path) -> bool:
@@ -91,8 +110,7 @@ def run_one(prog: Path, reference: str) -> int:
         if extra.exists():
             args += extra.read_text().split()
         args.append("prog.ngc")
-        done = subprocess.run(args, cwd=work, capture_output=True,
-                              timeout=60)
+        done = run_reference(args, str(work), 60)
     prog.with_suffix(".out").write_bytes(done.stdout)
     prog.with_suffix(".status").write_text(f"{done.returncode}\n")
     err = done.stderr.decode("utf-8", "replace")
