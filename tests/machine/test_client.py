@@ -46,6 +46,10 @@ from halsdk.machine.remote_status import (
 )
 from halsdk.testing import private_instance_name
 
+#: a machine running in real time whose position the tests read exactly:
+#: run alone in CI (beside another test the sim's servo lags)
+pytestmark = pytest.mark.serial
+
 PART = "G21 G90\nG0 X2 Y1\nG1 X3 F600\nM2\n"
 # slow feed moves (1 mm/s): a program that is still running when paused
 SLOW = "G21 G90\nG1 X10 F60\nG1 Y10\nG1 X0\nG1 Y0\nM2\n"
