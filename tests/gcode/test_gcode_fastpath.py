@@ -18,6 +18,7 @@ from __future__ import annotations
 import copy
 import os
 import tempfile
+from typing import Optional
 
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -53,6 +54,19 @@ def canon_of(ref: bool) -> RecordingCanon:
     return ReferenceCanon() if ref else RecordingCanon()
 
 
+def set_up(setup: list[str], ref: bool
+           ) -> Optional[tuple[Interpreter, Interpreter]]:
+    """An interpreter (with the rs274 canon when ``ref``) after the lines
+    ``setup``, and a copy of it; None for a setup it refuses."""
+    params = Parameters()
+    fast = Interpreter(params, None, canon_of(ref))
+    try:
+        fast.run(Program("\n".join(setup) + "\n", "s.ngc", params))
+    except GCodeError:
+        return None
+    return fast, copy.deepcopy(fast)
+
+
 def state(interp: Interpreter, canon: RecordingCanon) -> tuple:
     return (canon.commands, interp.pos, interp.feed, interp.feed_value,
             interp.diameter_mode, vars(interp.modal), interp.line,
@@ -72,14 +86,10 @@ def outcome(fn, block) -> object:
 def test_plain_moves_take_the_general_path_s_way(setup: list[str],
                                                  move: tuple,
                                                  ref: bool) -> None:
-    params = Parameters()
-    canon = canon_of(ref)
-    fast = Interpreter(params, None, canon)
-    try:
-        fast.run(Program("\n".join(setup) + "\n", "s.ngc", params))
-    except GCodeError:
+    pair = set_up(setup, ref)
+    if pair is None:
         return                      # a setup the interpreter refuses
-    general = copy.deepcopy(fast)
+    fast, general = pair
     code, words = move
     text = " ".join([code] + [f"{letter}{v}" for letter, v in words])
     blocks = list(Program(text + "\n", "m.ngc", Parameters()).blocks())
@@ -137,14 +147,10 @@ COMMENT = st.sampled_from([
 def test_comments_take_the_general_path_s_way(setup: list[str],
                                               text: str,
                                               ref: bool) -> None:
-    params = Parameters()
-    canon = canon_of(ref)
-    fast = Interpreter(params, None, canon)
-    try:
-        fast.run(Program("\n".join(setup) + "\n", "s.ngc", params))
-    except GCodeError:
-        return
-    general = copy.deepcopy(fast)
+    pair = set_up(setup, ref)
+    if pair is None:
+        return                      # a setup the interpreter refuses
+    fast, general = pair
     blocks = list(Program(text + "\n", "m.ngc", Parameters()).blocks())
     if not blocks:
         return
@@ -179,13 +185,10 @@ def test_arcs_take_the_general_path_s_way(setup: list[str], code: str,
         helix = ""
     move = (f"{code} {first}{2 * float(i)} {second}{2 * float(j)} "
             f"{w1}{i} {w2}{j}{helix}{extra}")
-    params = Parameters()
-    fast = Interpreter(params, None, canon_of(ref))
-    try:
-        fast.run(Program("\n".join(setup) + "\n", "s.ngc", params))
-    except GCodeError:
-        return
-    general = copy.deepcopy(fast)
+    pair = set_up(setup, ref)
+    if pair is None:
+        return                      # a setup the interpreter refuses
+    fast, general = pair
     block = next(Program(move + "\n", "m.ngc", Parameters()).blocks())
     assert outcome(fast.execute, block) == outcome(general._execute, block)
     assert state(fast, fast.canon) == state(general, general.canon)
