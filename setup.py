@@ -173,6 +173,10 @@ components.append(Extension(
 components.append(Extension(
     "halsdk.gcode._eval", sources=["halsdk/gcode/_eval.pyx"],
     extra_compile_args=FLAGS + ["-ffp-contract=off"]))
+# the control flow of a program (halsdk/gcode/_flow.pyx: Program._run)
+components.append(Extension(
+    "halsdk.gcode._flow", sources=["halsdk/gcode/_flow.pyx"],
+    extra_compile_args=FLAGS))
 names = [e.name for e in components]
 if len(set(names)) != len(names):
     sys.exit("error: two sources in components/ make the same module")

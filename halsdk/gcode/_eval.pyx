@@ -16,11 +16,20 @@ the values and the errors (message, column) are the Python ones.  The
 arithmetic is the one Python does (the same libm functions, the same
 constants for degrees; no fused multiply-add), which property tests
 check.
+
+:func:`make_block` and :func:`assign_planned` (the blocks of general lines) work
+from a :class:`Plan` of the line; the control flow (``_flow.pyx``) keeps
+the plans of the lines that run again.
 """
 
+cimport cython
 from libc.math cimport (acos, asin, atan2, ceil, cos, exp, fabs, floor,
                         fmod, isfinite, log, pow, round as c_round, sin,
                         sqrt, tan)
+
+cdef extern from "Python.h":
+    int _set "PyObject_GenericSetAttr" (object o, object name,
+                                        object value) except -1
 
 from .expr import (Atan, Binary, Exists, Function, Negate, Number, ParamRef,
                    Where)
@@ -63,10 +72,12 @@ def _give_up_node():
     return GIVE_UP_NODE
 
 
+@cython.no_gc
 cdef class Node:
     """A compiled node; this one always gives up.  Nodes do not change
     once made: a copy is the node itself, a pickle gives up (the Python
-    tree evaluates)."""
+    tree evaluates).  A tree of nodes holds no cycle (nodes, names):
+    the cyclic garbage collector need not look at them."""
 
     cdef double ev(self, object p) except? -1.0:
         raise GIVE_UP
@@ -81,6 +92,7 @@ cdef class Node:
         return (_give_up_node, ())
 
 
+@cython.no_gc
 cdef class Const(Node):
     cdef double value
 
@@ -97,6 +109,7 @@ cdef inline double _as_double(object value) except? -1.0:
     return float(value)
 
 
+@cython.no_gc
 cdef class Named(Node):
     """``#<name>``: a local name, or a global (``_``) one that the
     predefined-name callback answers first."""
@@ -141,6 +154,7 @@ cdef inline double _numbered(object p, long number) except? -1.0:
     return 0.0 if value is None else _as_double(value)
 
 
+@cython.no_gc
 cdef class Numbered(Node):
     """``#n`` of a constant number n."""
     cdef long number
@@ -164,6 +178,7 @@ cdef inline long _index(double value) except -1:
     return <long>number
 
 
+@cython.no_gc
 cdef class Indirect(Node):
     """``#[expr]``, ``##n``."""
     cdef Node index
@@ -175,6 +190,7 @@ cdef class Indirect(Node):
         return _numbered(p, _index(self.index.ev(p)))
 
 
+@cython.no_gc
 cdef class Neg(Node):
     cdef Node operand
 
@@ -185,6 +201,7 @@ cdef class Neg(Node):
         return -self.operand.ev(p)
 
 
+@cython.no_gc
 cdef class Func(Node):
     cdef Node operand
     cdef int code
@@ -242,6 +259,7 @@ cdef class Func(Node):
         return r
 
 
+@cython.no_gc
 cdef class Atan2(Node):
     cdef Node y
     cdef Node x
@@ -258,6 +276,7 @@ cdef class Atan2(Node):
         return atan2(y, x) * RAD_TO_DEG
 
 
+@cython.no_gc
 cdef class Exist(Node):
     cdef str name
 
@@ -272,6 +291,7 @@ cdef inline bint _eq(double a, double b):
     return fabs(a - b) < TOLERANCE_EQUAL
 
 
+@cython.no_gc
 cdef class Bin(Node):
     cdef Node left
     cdef Node right
@@ -380,14 +400,16 @@ cdef Node _compile(object expr):
 
 
 cdef inline Node compiled(object expr):
-    cdef object node
-    try:
-        node = expr.__dict__.get(COMPILED)
-    except AttributeError:          # a tree without __dict__
-        return _compile(expr)
+    """The compiled node of ``expr``, kept on it (an attribute, set as
+    ``object.__setattr__`` sets it: a tree with no room for it is
+    compiled again each time)."""
+    cdef object node = getattr(expr, COMPILED, None)
     if node is None:
         node = _compile(expr)
-        expr.__dict__[COMPILED] = node
+        try:
+            _set(expr, COMPILED, node)
+        except AttributeError:
+            pass
     return <Node>node
 
 
@@ -458,67 +480,170 @@ cdef bint _assign(object params, object key, double value) except -1:
     return False
 
 
-def assign(object program, object line):
-    """What ``make_block(program, line)`` does to a line of assignments
-    only (no words, no comments): apply them."""
+@cython.no_gc
+cdef class _Word:
+    """A word of a line: its letter, its value's tree and compiled node
+    (no cycle through it, as through a Plan)."""
+    cdef str letter
+    cdef bint code              # a G or M word
+    cdef object value, key      # a constant G or M word's value and key
+    cdef object expr
+    cdef Node node
+    cdef object column
+
+
+@cython.no_gc
+cdef class _Assign:
+    """An assignment of a line: its target, its value's tree and node."""
+    cdef object target          # the ParamRef
+    cdef object name            # the target's name, None for a number
+    cdef object expr
+    cdef Node node
+    cdef object column
+
+
+@cython.no_gc
+cdef class Plan:
+    """A line read once for :func:`make_planned` and
+    :func:`assign_planned`: what they read of the line, and the compiled
+    nodes of its values, so that a line that runs again (in a loop, in a
+    subroutine) is not looked at again.  Made by :func:`plan`; a line
+    must not change once planned.  A plan holds its line and the line's
+    trees and nodes, none of which refers back to it: no cycle goes
+    through a plan, and the cyclic garbage collector does not look at
+    it."""
+    cdef object line
+    cdef str file
+    cdef long number
+    cdef str text
+    cdef object block_delete, line_number
+    cdef list words             # of _Word
+    cdef list assigns           # of _Assign
+    cdef list comments
+
+
+cdef inline Node _node_of(object expr):
+    if type(expr) is Number:
+        return Const(expr.value)
+    return compiled(expr)
+
+
+def plan(object line):
+    """The :class:`Plan` of ``line``."""
+    cdef Plan p = Plan.__new__(Plan)
+    cdef _Word w
+    cdef _Assign a
+    cdef object word, assignment, index
+    p.line = line
+    p.file = line.file
+    p.number = line.number
+    p.text = line.text
+    p.block_delete = line.block_delete
+    p.line_number = line.line_number
+    p.words = []
+    p.assigns = []
+    p.comments = line.comments
+    for word in line.words:
+        w = _Word.__new__(_Word)
+        w.letter = word.letter
+        w.code = w.letter == "g" or w.letter == "m"
+        w.expr = word.value
+        w.node = _node_of(w.expr)
+        w.column = word.column
+        if w.code and type(w.node) is Const:
+            w.value = _round((<Const>w.node).value, 4)
+            w.key = code_key(w.letter, w.value)
+        p.words.append(w)
+    for assignment in line.assignments:
+        a = _Assign.__new__(_Assign)
+        a.target = assignment.target
+        index = a.target.index      # ParamRef.key of a name: the name
+        a.name = index if type(index) is str else None
+        a.expr = assignment.value
+        a.node = _node_of(a.expr)
+        a.column = assignment.column
+        p.assigns.append(a)
+    return p
+
+
+cdef inline double _ev(Node node, object expr, object params, str file,
+                       long line) except? -1.0:
+    """:func:`evaluate` of a planned value."""
+    try:
+        return node.ev(params)
+    except (_GiveUp, GCodeError):
+        return expr.evaluate(params, Where(file, line))
+
+
+cdef int _apply(object program, Plan p) except -1:
+    """Apply the assignments of ``p``: every value first, then the
+    parameters (the reference's order)."""
     cdef object params = program.params
-    cdef str file = line.file
-    cdef long number = line.number
     cdef list values = []
-    cdef object key, a, value
-    for a in line.assignments:
-        key = a.target.index
-        if type(key) is not str:
-            key = program._parameter_key(a.target, line)
-        values.append((key, evaluate(a.value, params, file, number),
+    cdef _Assign a
+    cdef object key, value, column
+    for a in p.assigns:
+        key = a.name
+        if key is None:
+            key = program._parameter_key(a.target, p.line)
+        values.append((key, _ev(a.node, a.expr, params, p.file, p.number),
                        a.column))
     for key, value, column in values:
         if not _assign(params, key, value):
-            program._set(key, value, line, column)
+            program._set(key, value, p.line, column)
+    return 0
+
+
+def assign_planned(object program, Plan p):
+    """What :func:`make_planned` does to a line of assignments only (no
+    words, no comments): apply them."""
+    _apply(program, p)
 
 
 def make_block(object program, object line):
     """``Program._block(line)``: the words of ``line`` evaluated into a
     :class:`Block`, its assignments applied."""
+    return make_planned(program, plan(line))
+
+
+def make_planned(object program, Plan p):
+    """:func:`make_block` of a planned line."""
     cdef object params = program.params
-    cdef str file = line.file
-    cdef long number = line.number
-    cdef list g = [], m = [], values = []
+    cdef str file = p.file
+    cdef long number = p.number
+    cdef object line = p.line
+    cdef list g = [], m = []
     cdef dict words = {}, columns = {}
     cdef list comments = []
     cdef object message = None
-    cdef object word, value, key, a, comment, block
+    cdef object value, key, comment, block
     cdef str letter, kind
-    cdef double v
+    cdef _Word w
     if _DIRECT_BLOCK:
         block = _new(Block)
     else:
-        block = Block(file, number, line.text)
-    for word in line.words:
-        letter = word.letter
-        v = evaluate(word.value, params, file, number)
-        if letter == "g" or letter == "m":
-            value = _round(v, 4)
-            key = code_key(letter, value)
+        block = Block(file, number, p.text)
+    for w in p.words:
+        letter = w.letter
+        if w.code:
+            if w.key is not None:
+                value = w.value     # a constant code, ready
+                key = w.key
+            else:
+                value = _round(_ev(w.node, w.expr, params, file, number), 4)
+                key = code_key(letter, value)
             if letter == "g":
                 g.append(value)
             else:
                 m.append(value)
-            columns.setdefault(key, word.column)
-            columns.setdefault(letter, word.column)
+            columns.setdefault(key, w.column)
+            columns.setdefault(letter, w.column)
         else:
-            words[letter] = v
-            columns[letter] = word.column
-    for a in line.assignments:
-        key = a.target.index        # ParamRef.key of a name: the name
-        if type(key) is not str:
-            key = program._parameter_key(a.target, line)
-        values.append((key,
-                       evaluate(a.value, params, file, number), a.column))
-    for key, value, column in values:
-        if not _assign(params, key, value):
-            program._set(key, value, line, column)
-    for comment in line.comments:
+            words[letter] = _ev(w.node, w.expr, params, file, number)
+            columns[letter] = w.column
+    if p.assigns:
+        _apply(program, p)
+    for comment in p.comments:
         kind = comment.kind
         if kind == "msg":
             message = comment.text
@@ -529,13 +654,13 @@ def make_block(object program, object line):
     d = block.__dict__
     d["file"] = file
     d["line"] = number
-    d["text"] = line.text
+    d["text"] = p.text
     d["g"] = g
     d["m"] = m
     d["words"] = words
     d["columns"] = columns
     d["comments"] = comments
     d["message"] = message
-    d["block_delete"] = line.block_delete
-    d["line_number"] = line.line_number
+    d["block_delete"] = p.block_delete
+    d["line_number"] = p.line_number
     return block

@@ -281,6 +281,37 @@ cdef object _simple_block(str file, int number, str text,
     return block
 
 
+def candidate_lines(bytes chunk, Py_ssize_t end):
+    """The lines of ``chunk[:end]`` that may be o-word or '%' lines (they
+    hold an 'o', 'O' or '%'), for the first pass over a program file:
+    ``(count, found)``, the number of lines of ``chunk[:end]`` (a last
+    one without its line end counted) and a list of ``(line, start,
+    stop)``: the line's number in the chunk (from 0) and where its text
+    is, without its '\\n'."""
+    cdef const char *s = chunk
+    cdef Py_ssize_t i, start = 0, line = 0
+    cdef bint hit = False
+    cdef char c
+    cdef list found = []
+    if end > len(chunk):
+        raise ValueError("end past the chunk")
+    for i in range(end):
+        c = s[i]
+        if c == 10:
+            if hit:
+                found.append((line, start, i))
+                hit = False
+            line += 1
+            start = i + 1
+        elif c == 111 or c == 79 or c == 37:        # o O %
+            hit = True
+    if start < end:
+        if hit:
+            found.append((line, start, end))
+        line += 1
+    return line, found
+
+
 #: what :func:`read_line` gives for a plain line without words
 EMPTY = ("empty line",)
 #: the class of streamed program files (program._FileLines, set by it)
@@ -477,11 +508,39 @@ cdef inline _emit(object interp, object command):
         interp.canon.emit(command)
 
 
+cdef bint _block_ready(object interp, object block) except -1:
+    """Whether the state lets the short path take ``block``: it knows
+    neither G7 diameters, nor a rotated coordinate system, nor the M73
+    restore, nor an arc's turns (a P word, checked before the line
+    runs), nor the reference's extra calls of ``rs274`` (its feed calls
+    among them), nor the comments of a line (maybe a LOG, PROBEOPEN or
+    py comment)."""
+    cdef dict words = block.words
+    cdef bint ref = interp.ref
+    cdef object modal
+    cdef str axis
+    if interp.diameter_mode or interp._autosaved or "p" in words \
+            or ("f" in words and ref) or block.comments:
+        return False
+    modal = interp.modal
+    if ref:
+        if modal.feed_mode == 930:
+            return False
+        for axis in _AXES:
+            if axis in words:
+                break
+        else:
+            return False
+    return not interp.params.get(
+        5210 + 20 * (_COORD_CODES.index(modal.coord_system) + 1))
+
+
 def fast_move(object interp, object block):
     """``Interpreter._fast``: execute a plain move (G0-G3 or the modal
     motion; axis words, F and arc words only; no cutter compensation)
     as ``Interpreter.execute`` does, in fewer steps; False, having
-    changed nothing, for any other block.
+    changed nothing, for any other block, or in a state it does not
+    know (:func:`_block_ready`).
 
     It does what ``execute``, ``_target``, ``_straight_feed`` and
     ``_traverse`` do for such a block: a change to what a plain move
@@ -493,7 +552,8 @@ def fast_move(object interp, object block):
     cdef int motion
     cdef bint has_axes = False, arc_words = False
     cdef str letter
-    if block.m or len(g) > 1 or block.message is not None:
+    if block.m or len(g) > 1 or block.message is not None \
+            or not _block_ready(interp, block):
         return False
     modal = interp.modal
     if g:
@@ -688,7 +748,7 @@ cdef inline object _command(object cls, dict fields):
 
 cdef bint _ready_state(object interp, object modal, Machine *m) except -1:
     """Read the state into ``m``; False when it is one that the short
-    path does not know (see Interpreter._fast_ready and fast_move): the
+    path does not know (see _block_ready and fast_move): the
     reference's calls, G7, a rotated coordinate system, the M73
     restore, inverse time, cutter compensation."""
     cdef dict numbered

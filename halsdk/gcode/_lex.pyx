@@ -20,6 +20,10 @@ from .lexer import (O_KEYWORDS, Assignment, Comment, Line, OWord, Word,
 cdef extern from "Python.h":
     double PyOS_string_to_double(const char *s, char **endptr,
                                  object overflow_exception) except? -1.0
+    # what the dataclass __init__'s "self.name = value" does, without a
+    # call: the values stay in the instance (no __dict__ is made)
+    int _set "PyObject_GenericSetAttr" (object o, object name,
+                                        object value) except -1
 
 
 class _Fail(Exception):
@@ -253,7 +257,8 @@ cdef class _Reader:
                 raise FAIL
             self.pos += 1
             e = _new(Exists)
-            e.__dict__.update(name=target, column=column)
+            _set(e, "name", target)
+            _set(e, "column", column)
             return e
         if name not in _FUNCTIONS:
             raise FAIL
@@ -317,8 +322,10 @@ cdef class _Reader:
         elif keyword in ("return", "endsub") and len(args) > 1:
             raise FAIL
         o = _new(OWord)
-        o.__dict__.update(name=name, keyword=keyword, args=args,
-                          column=column)
+        _set(o, "name", name)
+        _set(o, "keyword", keyword)
+        _set(o, "args", args)
+        _set(o, "column", column)
         return o
 
 
@@ -326,59 +333,53 @@ cdef class _Reader:
 
 cdef inline object _number(double value, int column):
     cdef object o = _new(Number)
-    cdef dict d = o.__dict__
-    d["value"] = value
-    d["column"] = column
+    _set(o, "value", value)
+    _set(o, "column", column)
     return o
 
 
 cdef inline object _param(object index, int column):
     cdef object o = _new(ParamRef)
-    cdef dict d = o.__dict__
-    d["index"] = index
-    d["column"] = column
+    _set(o, "index", index)
+    _set(o, "column", column)
     return o
 
 
 cdef inline object _negate(object operand, int column):
     cdef object o = _new(Negate)
-    cdef dict d = o.__dict__
-    d["operand"] = operand
-    d["column"] = column
+    _set(o, "operand", operand)
+    _set(o, "column", column)
     return o
 
 
 cdef inline object _function(str name, object operand, int column):
     cdef object o = _new(Function)
-    cdef dict d = o.__dict__
-    d["name"] = name
-    d["operand"] = operand
-    d["column"] = column
+    _set(o, "name", name)
+    _set(o, "operand", operand)
+    _set(o, "column", column)
     return o
 
 
 cdef inline object _atan(object y, object x, int column):
     cdef object o = _new(Atan)
-    cdef dict d = o.__dict__
-    d["y"] = y
-    d["x"] = x
-    d["column"] = column
+    _set(o, "y", y)
+    _set(o, "x", x)
+    _set(o, "column", column)
     return o
 
 
 cdef inline object _binary(str op, object left, object right, int column):
     cdef object o = _new(Binary)
-    cdef dict d = o.__dict__
-    d["op"] = op
-    d["left"] = left
-    d["right"] = right
-    d["column"] = column
+    _set(o, "op", op)
+    _set(o, "left", left)
+    _set(o, "right", right)
+    _set(o, "column", column)
     return o
 
 
 cdef bint _plain_dataclass(object cls, tuple names):
     """True if instances of ``cls`` may be made by filling their
-    __dict__ (what the dataclass __init__ does): the fields are just
+    attributes (what the dataclass __init__ does): the fields are just
     ``names`` and __init__ does nothing else."""
     import dataclasses
     return (tuple(f.name for f in dataclasses.fields(cls)) == names
@@ -397,7 +398,26 @@ cdef bint _DIRECT = all([
     _plain_dataclass(OWord, ("name", "keyword", "args", "column")),
     _plain_dataclass(Word, ("letter", "value", "column")),
     _plain_dataclass(Assignment, ("target", "value", "column")),
+    _plain_dataclass(Line, ("file", "number", "text", "block_delete",
+                            "line_number", "words", "assignments",
+                            "comments", "oword", "percent")),
 ])
+
+
+cdef object _line(str file, long number, str text, list comments):
+    """``Line(file, number, text, comments=comments)``."""
+    cdef object line = _new(Line)
+    _set(line, "file", file)
+    _set(line, "number", number)
+    _set(line, "text", text)
+    _set(line, "block_delete", False)
+    _set(line, "line_number", None)
+    _set(line, "words", [])
+    _set(line, "assignments", [])
+    _set(line, "comments", comments)
+    _set(line, "oword", None)
+    _set(line, "percent", False)
+    return line
 
 
 cdef object _read(_Reader r, object line):
@@ -436,8 +456,9 @@ cdef object _read(_Reader r, object line):
                 raise FAIL
             r.pos += 1
             w = _new(Assignment)
-            w.__dict__.update(target=target, value=r.real_value(),
-                              column=column)
+            _set(w, "target", target)
+            _set(w, "value", r.real_value())
+            _set(w, "column", column)
             assignments.append(w)
             continue
         if not _is_alpha(c) or c == 111 or c == 110:   # o, n
@@ -448,8 +469,9 @@ cdef object _read(_Reader r, object line):
                 raise FAIL
             seen[c] = 1
         w = _new(Word)
-        w.__dict__.update(letter=_LETTERS[c], value=r.real_value(),
-                          column=column)
+        _set(w, "letter", _LETTERS[c])
+        _set(w, "value", r.real_value())
+        _set(w, "column", column)
         words.append(w)
     return line
 
@@ -501,7 +523,7 @@ def parse_line(str text, str file="<string>", long lineno=1):
     r.n = n
     r.pos = 0
     r.end_column = size + 1
-    line = Line(file, lineno, text, comments=comments)
+    line = _line(file, lineno, text, comments)
     try:
         return _read(r, line)
     except _Fail:

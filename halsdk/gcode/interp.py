@@ -348,6 +348,26 @@ class Interpreter:
         else:                       # logopen, logappend: the name as is
             self._trace(f'{kind.upper()}("{text}")')
 
+    @staticmethod
+    def inert_comments(text: str) -> bool:
+        """True if the line ``text``, of plain comments only, is one that
+        :meth:`execute` does nothing with but name it the current line,
+        when :meth:`quiet_comments` holds: no ``;py,`` line, and its last
+        comment is neither an active one nor PROBEOPEN/PROBECLOSE (see
+        :meth:`_comment_canon`).  The program's control flow does not
+        hand out the blocks of such lines (``_flow.run``)."""
+        if text.startswith(";py,"):
+            return False
+        found = last_comment(text)
+        return found is None or (found[0] == ""
+                                 and probe_comment(found[1]) is None)
+
+    def quiet_comments(self) -> bool:
+        """Whether a block of plain comments does nothing now (see
+        :meth:`inert_comments` and :meth:`execute`): no REMAP, not the
+        reference's output (its COMMENT calls), no M73 restore pending."""
+        return self.remap is None and not self.ref and not self._autosaved
+
     def _comment_canon(self, block: Block) -> None:
         """The file comments of the line on a machine (see
         :func:`last_comment` and :func:`probe_comment`): LOG* and PROBE*
@@ -439,25 +459,9 @@ class Interpreter:
             self.line_block = block
             self._comment_canon(block)
             return
-        if self._fast_ready(block) and fast_move(self, block):
+        if fast_move(self, block):
             return
         self._execute(block)
-
-    def _fast_ready(self, block: Block) -> bool:
-        """Whether the state lets the short path take ``block``: it knows
-        neither G7 diameters, nor a rotated coordinate system, nor the
-        M73 restore, nor an arc's turns (a P word, checked before the
-        line runs), nor the reference's extra calls of ``rs274`` (its
-        feed calls among them)."""
-        if self.diameter_mode or self._autosaved or "p" in block.words \
-                or "f" in block.words and self.ref:
-            return False
-        if self.ref and (block.comments or self.modal.feed_mode == 930
-                         or AXIS_SET.isdisjoint(block.words)):
-            return False
-        if block.comments:
-            return False            # maybe a LOG, PROBEOPEN or py comment
-        return not self.params.get(5210 + 20 * self.coord_index)
 
     def _execute(self, block: Block) -> None:
         """:meth:`execute` without the short path of plain moves."""

@@ -47,8 +47,11 @@ def normalize_name(name: str) -> str:
 class _Frame:
     """The local parameters of one subroutine call (or the top level)."""
 
-    def __init__(self) -> None:
-        self.numbered: dict[int, float] = {}
+    __slots__ = ("numbered", "named")
+
+    def __init__(self, numbered: Optional[dict[int, float]] = None) -> None:
+        self.numbered: dict[int, float] = numbered if numbered is not None \
+            else {}
         self.named: dict[str, float] = {}
 
 
@@ -89,9 +92,8 @@ class Parameters:
         if args is not None and len(args) > len(LOCAL_NUMBERED):
             raise GCodeError(f"at most {len(LOCAL_NUMBERED)} subroutine "
                              f"arguments, got {len(args)}")
-        frame = _Frame()
-        for index, value in enumerate(args or (), start=1):
-            frame.numbered[index] = float(value)
+        frame = _Frame({index: float(value) for index, value
+                        in enumerate(args, start=1)} if args else None)
         self._frames.append(frame)
         self._top = frame
 

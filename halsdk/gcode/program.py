@@ -10,8 +10,9 @@ from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from typing import Any, BinaryIO, Optional, Union
 
-from ._eval import assign, evaluate, make_block
-from ._fast import EMPTY, read_line, run_plain, set_file_lines
+from ._eval import evaluate, make_block
+from ._fast import candidate_lines, set_file_lines
+from ._flow import run as run_flow
 from .block import Block, code_key
 from .errors import GCodeError
 from .expr import Expr, ParamRef, Where
@@ -83,17 +84,6 @@ def _other_line_ends(chunk: bytes, end: int, ascii: bool) -> bool:
     return any(chunk.find(other, 0, end) >= 0 for other in others)
 
 
-def _candidates(chunk: bytes, end: int) -> Iterator[int]:
-    """The offsets of 'o', 'O' and '%' in ``chunk[:end]``, ascending
-    (bytes.find runs at memchr speed, a regular expression does not)."""
-    found = [(chunk.find(c, 0, end), c) for c in (b"o", b"O", b"%")]
-    heads = sorted((at, c) for at, c in found if at >= 0)
-    while heads:
-        at, c = heads.pop(0)
-        yield at
-        following = chunk.find(c, at + 1, end)
-        if following >= 0:
-            bisect.insort(heads, (following, c))
 #: Size of the pieces a program file is scanned in.
 _CHUNK = 1 << 20
 
@@ -209,24 +199,13 @@ def _read_file(path: str) -> tuple[Union[_TextLines, _FileLines],
                     return _read_text(path)
                 if not ascii:
                     chunk[:cut].decode("utf-8")  # the error a text read gives
-                counted = 0     # newlines before here are in ``index``
-                skip = 0        # the end of the last candidate line
-                for at in _candidates(chunk, cut):
-                    if at < skip:
-                        continue        # a second one on the same line
-                    start = chunk.rfind(b"\n", 0, at) + 1
-                    stop = chunk.find(b"\n", at, cut)
-                    stop = cut if stop < 0 else stop
-                    index += chunk.count(b"\n", counted, start)
-                    counted = start
-                    offsets[index] = base + start
+                lines, found = candidate_lines(chunk, cut)
+                for line, start, stop in found:
+                    offsets[index + line] = base + start
                     candidates.append(
-                        (index, chunk[start:stop].decode("utf-8")
+                        (index + line, chunk[start:stop].decode("utf-8")
                          .rstrip("\r\n")))
-                    skip = stop + 1
-                index += chunk.count(b"\n", counted, cut)
-                if chunk[cut - 1] != 10:
-                    index += 1          # a last line without its line end
+                index += lines
                 base += cut
                 if not piece:
                     break
@@ -291,6 +270,8 @@ class _Unit:
                 self._keep_starts.append(first)
                 self._keep_ends.append(last)
         self._kept: dict[int, _Entry] = {}
+        #: the lines that run again, compiled (by ``_flow.run``)
+        self._codes: dict[int, Any] = {}
 
     @classmethod
     def from_text(cls, text: str, file: str) -> _Unit:
@@ -442,15 +423,6 @@ def _scan(unit: _Unit) -> _Structure:
     return result
 
 
-@dataclass
-class _Frame:
-    """A subroutine call in progress."""
-
-    return_unit: _Unit
-    return_index: int
-    name: str
-
-
 class Program:
     """A G-code program: lines, expressions, parameters, o-word subroutines
     and loops.
@@ -494,8 +466,7 @@ class Program:
         #: loop iterations and subroutine calls of the current (or last)
         #: run of :meth:`blocks`; never more than ``max_iterations``
         self.iterations = 0
-        self._idle_since = 0.0
-        self._frames: list[_Frame] = []
+        self._frames: list[Any] = []
         self._main = _Unit.from_text(text, file)
         self._files: dict[str, _Unit] = {}
         #: ``python_subs(name)``: a Python subroutine for ``o<name> call``
@@ -629,7 +600,6 @@ class Program:
         every block it gets with that interpreter, and nothing else."""
         self.params.reset_scopes()
         self.iterations = 0
-        self._idle_since = self.clock()
         try:
             yield from self._run(interp)
         finally:
@@ -643,7 +613,6 @@ class Program:
         code's procedure, G-code run by Python): the parameter scopes of
         the running program are left as they are."""
         self.iterations = 0
-        self._idle_since = self.clock()
         yield from self._run()
 
     def share_files(self, other: Program) -> None:
@@ -651,196 +620,8 @@ class Program:
         self._files = other._files
 
     def _run(self, interp: Any = None) -> Iterator[Block]:
-        unit = self._main
-        index = 0
-        frames: list[_Frame] = []
-        self._frames = frames
-        repeats: dict[tuple[int, int], int] = {}
-        seen_code = False
-        clock = self.clock
-        structure = unit.structure
-        params = self.params
-        while True:
-            if interp is None:
-                entry = read_line(unit, index)
-            else:
-                # plain moves run at once; the line it stops at is ours
-                index, entry, ran = run_plain(unit, index, interp,
-                                              not frames)
-                if ran:
-                    seen_code = True
-                    self._idle_since = clock()
-            if entry is None:
-                if frames:  # pragma: no cover - the scan rules it out
-                    raise GCodeError(
-                        f"end of file inside {_label(frames[-1].name)}",
-                        unit.file, unit.count, 1)
-                return
-            if not frames and structure.sub_starts and \
-                    structure.sub_starts[0] <= index <= structure.sub_ends[-1]:
-                end = structure.sub_end(index)
-                if end >= 0:
-                    # a subroutine definition met in the main flow: skip it
-                    index = end + 1
-                    continue
-            if entry.__class__ is Block:
-                # the fast path: a line of plain numbered words
-                index += 1
-                seen_code = True
-                clock()
-                yield entry
-                self._idle_since = clock()
-                if entry.m and any(abs(m - 2) < 1e-6 or abs(m - 30) < 1e-6
-                                   for m in entry.m):
-                    return
-                continue
-            if entry is EMPTY:
-                index += 1
-                continue
-            if isinstance(entry, GCodeError):
-                raise entry
-            assert isinstance(entry, Line)
-            line = entry
-            if line.percent:
-                if seen_code and unit.percents[0] == index:
-                    # only a program opened with '%' may close with one
-                    raise GCodeError("Bad character '%' used", line.file,
-                                     line.number, line.text.find("%") + 1)
-                if seen_code or unit.percents and unit.percents[0] < index:
-                    return
-                index += 1
-                continue
-            if line.block_delete and self.block_delete:
-                index += 1
-                continue
-            oword = line.oword
-            if oword is None:
-                index += 1
-                if line.words:
-                    seen_code = True
-                elif not line.comments:
-                    if line.assignments:
-                        assign(self, line)      # no block to hand out
-                    continue
-                block = make_block(self, line)
-                working = bool(block.g or block.m or block.words
-                               or block.message is not None)
-                if working or block.comments:
-                    handed = clock()
-                    yield block
-                    if working:
-                        self._idle_since = clock()
-                    else:   # the time the consumer held it is not idle
-                        self._idle_since += clock() - handed
-                if block.m and any(abs(m - 2) < 1e-6 or abs(m - 30) < 1e-6
-                                   for m in block.m):
-                    return
-                continue
-            seen_code = True
-            keyword = oword.keyword
-
-            if keyword == "call":
-                name = oword.name if isinstance(oword.name, str) else \
-                    f"{evaluate(oword.name, params, line.file, line.number):g}"
-                python = self.python_subs(name) if self.python_subs \
-                    else None
-                if python is not None:
-                    self._python_call(python, oword, line)
-                    index += 1
-                    continue
-                target = self._find_sub(name, unit)
-                if target is None:
-                    # (the reference reads on to the end, looking for it)
-                    raise GCodeError(f"EOF in file:{unit.file} seeking "
-                                     f"o-word: o<{name}> from line: "
-                                     f"{line.number}", unit.file,
-                                     unit.count, 1)
-                if len(frames) >= self.max_call_depth:
-                    raise GCodeError("Too many subroutine levels", line.file,
-                                     line.number, oword.column)
-                self._count(unit, index, "subroutine call")
-                args = [evaluate(a, params, line.file, line.number)
-                        for a in oword.args]
-                if len(args) > 30:
-                    raise GCodeError("Too many subroutine parameters",
-                                     line.file, line.number, oword.column)
-                params.set_returned(None)
-                params.push_scope(args)
-                frames.append(_Frame(unit, index + 1, name))
-                unit = target
-                structure = unit.structure
-                index = target.structure.subs[name][0] + 1
-            elif keyword in ("return", "endsub"):
-                if keyword == "endsub" and not frames:
-                    index += 1
-                    continue
-                returned = evaluate(oword.args[0], params, line.file,
-                                    line.number) if oword.args else None
-                frame = frames.pop()
-                params.pop_scope()
-                if repeats:
-                    for key in [k for k in repeats if k[0] == id(frame)]:
-                        del repeats[key]
-                params.set_returned(returned)
-                unit, index = frame.return_unit, frame.return_index
-                structure = unit.structure
-            elif keyword == "sub":
-                index = structure.subs[_name_text(oword)][1] + 1
-            elif keyword == "if":
-                index = self._choose_branch(unit, index, line)
-            elif keyword in ("elseif", "else"):
-                index = structure.endif_of[index] + 1
-            elif keyword == "endif":
-                index += 1
-            elif keyword == "while" and index in structure.loop_start:
-                # the closing "while" of a do loop
-                opener = structure.loop_start[index]
-                if evaluate(oword.args[0], params, line.file, line.number):
-                    self._count(unit, opener, "loop")
-                    index = opener + 1
-                else:
-                    index += 1
-            elif keyword == "while":
-                if evaluate(oword.args[0], params, line.file, line.number):
-                    self._count(unit, index, "loop")
-                    index += 1
-                else:
-                    index = structure.loop_end[index] + 1
-            elif keyword == "do":
-                self._count(unit, index, "loop")
-                index += 1
-            elif keyword == "repeat":
-                count = int(evaluate(oword.args[0], params, line.file,
-                                     line.number))
-                repeats[(id(frames[-1]) if frames else 0, index)] = count
-                if count <= 0:
-                    index = structure.loop_end[index] + 1
-                else:
-                    self._count(unit, index, "loop")
-                    index += 1
-            elif keyword == "endrepeat":
-                opener = structure.loop_start[index]
-                key = (id(frames[-1]) if frames else 0, opener)
-                repeats[key] -= 1
-                if repeats[key] > 0:
-                    self._count(unit, opener, "loop")
-                    index = opener + 1
-                else:
-                    del repeats[key]
-                    index += 1
-            elif keyword == "endwhile":
-                index = structure.loop_start[index]
-            elif keyword == "break":
-                opener = structure.loop_of[index]
-                repeats.pop((id(frames[-1]) if frames else 0, opener), None)
-                index = structure.loop_end[opener] + 1
-            elif keyword == "continue":
-                opener = structure.loop_of[index]
-                index = opener if unit.keyword(opener) == "while" \
-                    else structure.loop_end[opener]
-            else:  # pragma: no cover - the lexer admits no other keyword
-                raise GCodeError(f"unsupported o-word {keyword}", line.file,
-                                 line.number, oword.column)
+        """The control flow, compiled (``_flow.run``)."""
+        return run_flow(self, interp)
 
     def _python_call(self, python: Callable[[list[float], str, int, int],
                                             Optional[float]],
@@ -854,47 +635,24 @@ class Program:
             self.params.set("_value", returned)
             self.params.set("_value_returned", 1.0)
 
-    def _count(self, unit: _Unit, index: int, what: str) -> None:
-        """Count one more loop iteration or subroutine call of this run
-        (line ``index`` of ``unit``); past a limit it is an error."""
-        if self.iterations >= self.max_iterations:
-            raise self._runaway(
-                unit, index,
+    def _runaway(self, unit: _Unit, index: int, what: str,
+                 idle: Optional[float]) -> GCodeError:
+        """The error of a loop iteration or a subroutine call (``what``,
+        line ``index`` of ``unit``) past a limit: the iterations, or the
+        ``idle`` time when it is given (``_flow.run`` counts)."""
+        if idle is None:
+            message = (
                 f"{what} exceeds the limit of {self.max_iterations} loop "
                 "iterations and subroutine calls in one run (endless "
                 "loop?); raise it with Program(max_iterations=...) or "
                 "[RS274NGC]HALSDK_MAX_ITERATIONS")
-        self.iterations += 1
-        idle = self.clock() - self._idle_since
-        if idle > self.max_idle_time:
-            raise self._runaway(
-                unit, index,
+        else:
+            message = (
                 f"{what} ran {idle:.3g} s without a block to execute, "
                 f"more than the limit of {self.max_idle_time:g} s "
                 "(endless loop?); raise it with Program(max_idle_time=...)"
                 " or [RS274NGC]HALSDK_MAX_IDLE_TIME")
-
-    @staticmethod
-    def _runaway(unit: _Unit, index: int, message: str) -> GCodeError:
         line = unit.owords[index]
         assert line.oword is not None
         return GCodeError(message, line.file, line.number,
                           line.oword.column)
-
-    def _choose_branch(self, unit: _Unit, index: int, line: Line) -> int:
-        """The line to continue at after ``O.. if`` at ``index``."""
-        oword = line.oword
-        assert oword is not None
-        if self._value(oword.args[0], line):
-            return index + 1
-        for branch in unit.structure.branches[index]:
-            entry = unit.owords[branch]
-            assert entry.oword is not None
-            keyword = entry.oword.keyword
-            if keyword == "else":
-                return branch + 1
-            if keyword == "endif":
-                return branch + 1
-            if self._value(entry.oword.args[0], entry):
-                return branch + 1
-        raise AssertionError("if without endif")  # pragma: no cover

@@ -10,7 +10,9 @@ commands, end in the same state and refuse the same blocks.
 moves itself, in compiled code, without making their blocks
 (``_fast.run_plain``).  Random programs, held in memory or streamed from
 a file, with loops and subroutines, must run as they do block by block,
-for the recording canon, the reference's calls and the ``rs274`` text.
+for the recording canon, the reference's calls and the ``rs274`` text;
+lines of plain comments only, which the control flow skips with the
+interpreter, among them.
 """
 
 from __future__ import annotations
@@ -366,6 +368,40 @@ def test_the_loop_takes_plain_moves_and_hands_out_the_rest() -> None:
     assert [b.text for b in program.blocks()] == ["G1 X1", "G1 X2"]
 
 
+def test_lines_of_plain_comments_are_not_handed_out() -> None:
+    # a line of plain comments does nothing but name the current line:
+    # with the interpreter, the control flow (_flow.run) does that itself;
+    # active comments, PROBEOPEN and lines with anything else are blocks
+    text = ("G21 F100\no<s> sub\n(just a note)\n  ( another )\n"
+            "(PROBEOPEN p.txt)\n(MSG, hello)\n(PROBECLOSE)\n#<k> = 1\n"
+            "G1 X#1\no<s> endsub\no1 repeat [2]\no<s> call [1]\n"
+            "(after the call)\no1 endrepeat\nM2\n")
+    params = Parameters()
+    canon = RecordingCanon()
+    interp = Interpreter(params, None, canon)
+    handed = []
+    for block in Program(text, "p.ngc", params).blocks(interp):
+        handed.append(block.text)
+        interp.execute(block)
+        if block.text == "(MSG, hello)":
+            assert interp.line == 6
+    assert handed == ["G21 F100"] + ["(PROBEOPEN p.txt)", "(MSG, hello)",
+                                     "(PROBECLOSE)", "G1 X#1"] * 2 + ["M2"]
+    general = RecordingCanon()
+    General(Parameters(), None, general).run(Program(text, "p.ngc"))
+    assert canon.commands == general.commands
+    # without the interpreter (the machine's executor), every one is
+    program = Program(text, "p.ngc", Parameters())
+    assert sum(b.text == "(just a note)" for b in program.blocks()) == 2
+    # nor when the interpreter would do something with them: the
+    # reference's COMMENT calls
+    ref = ReferenceCanon()
+    interp = Interpreter(Parameters(), None, ref)
+    interp.run(Program(text, "p.ngc"))
+    assert sum(c.text == 'COMMENT("just a note")'
+               for c in ref.commands if hasattr(c, "text")) == 2
+
+
 digits = st.text("0123456789", max_size=25)
 
 
@@ -403,3 +439,22 @@ def test_names_that_are_not_predefined_stay_so() -> None:
     assert interp._predefined("_x") == 3.0
     assert interp._predefined("_feed") == 200.0
     assert interp._predefined("_depth") is None
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.lists(st.text("oO%x \r;(G1)\n", max_size=12), max_size=12),
+       st.booleans())
+def test_the_first_pass_finds_every_line_with_an_o_or_percent(
+        pieces: list[str], last_line_end: bool) -> None:
+    # _fast.candidate_lines: the lines of a chunk that may be o-word or
+    # '%' lines, and the number of lines, as splitting the text finds
+    text = "".join(pieces) + ("\n" if last_line_end else "")
+    chunk = text.encode("ascii") + b"tail after the end"
+    count, found = _fast.candidate_lines(chunk, len(text))
+    lines = text.split("\n")
+    if lines[-1] == "":
+        lines.pop()
+    assert count == len(lines)
+    assert [(i, chunk[start:stop].decode()) for i, start, stop in found] \
+        == [(i, line) for i, line in enumerate(lines)
+            if any(c in line for c in "oO%")]
