@@ -200,7 +200,6 @@ def run(object program, object interp=None):
     cdef dict codes = unit._codes
     cdef dict kept = unit._kept
     cdef object inert_comments = None
-    cdef bint quiet = False         # the interpreter skips inert comments
     cdef object entry, line, oword, block, target, returned, python, name
     cdef _Code code
     cdef _Call call
