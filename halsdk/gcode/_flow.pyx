@@ -113,7 +113,7 @@ cdef _Code _compile(object unit, Py_ssize_t index, object line,
         code.jump = structure.subs[oword.name if isinstance(oword.name, str)
                                    else "?"][1] + 1
     elif code.kind == K_IF:
-        code.branches = [(b, _compile(unit, b, unit.owords[b], None))
+        code.branches = [(b, _code_of(unit, b))
                          for b in structure.branches[index]]
     elif code.kind == K_ELSE or code.kind == K_ELSEIF:
         code.jump = structure.endif_of[index] + 1
@@ -134,6 +134,17 @@ cdef _Code _compile(object unit, Py_ssize_t index, object line,
         code.opener = structure.loop_of[index]
         code.jump = code.opener if unit.keyword(code.opener) == "while" \
             else structure.loop_end[code.opener]
+    return code
+
+
+cdef _Code _code_of(object unit, Py_ssize_t index):
+    """The code of the o-word line ``index`` of ``unit``, compiled once
+    (an if's branches are run from the if and reached on their own)."""
+    cdef dict codes = unit._codes
+    cdef _Code code = codes.get(index)
+    if code is None:
+        code = _compile(unit, index, unit.owords[index], None)
+        codes[index] = code
     return code
 
 

@@ -126,9 +126,6 @@ def _bezier(points: list[tuple[float, float]], t: float
     return pts[0]
 
 
-#: The axis letters, as a set.
-AXIS_SET = frozenset(AXES)
-
 #: Letters every block may hold (the others need a code that uses them).
 ALWAYS_ALLOWED = frozenset(AXES + "fstno")
 
