@@ -471,6 +471,12 @@ cdef double _factor(object interp, object modal):
     return 25.4 if interp.machine_metric else 1 / 25.4
 
 
+cdef inline long _coord_base(object modal) except -1:
+    """20 times the number of the active coordinate system (G54: 1): the
+    offset of its parameters from #5201 (its X) and #5210 (its R)."""
+    return 20 * (_COORD_CODES.index(modal.coord_system) + 1)
+
+
 cdef list _target(object interp, dict words, object modal):
     """``Interpreter._target(block)`` (not G53): the machine end point
     from the axis words, the same arithmetic in the same order."""
@@ -487,7 +493,7 @@ cdef list _target(object interp, dict words, object modal):
     cdef dict numbered = interp.params._numbered
     # Interpreter._g5x(): the offsets of the active coordinate system
     # (numbers above the subroutine locals: read as Parameters.numbered)
-    base = 5201 + 20 * (_COORD_CODES.index(modal.coord_system) + 1)
+    base = 5201 + _coord_base(modal)
     for i in range(9):
         g5x[i] = numbered.get(base + i, 0.0)
     k = _factor(interp, modal)
@@ -531,8 +537,7 @@ cdef bint _block_ready(object interp, object block) except -1:
                 break
         else:
             return False
-    return not interp.params.get(
-        5210 + 20 * (_COORD_CODES.index(modal.coord_system) + 1))
+    return not interp.params.get(5210 + _coord_base(modal))  # G10 L2 R
 
 
 def fast_move(object interp, object block):
@@ -763,7 +768,7 @@ cdef bint _ready_state(object interp, object modal, Machine *m) except -1:
         return False
     if not (_DIRECT_FEED and _DIRECT_TRAVERSE and _DIRECT_ARC):
         return False
-    base = 20 * (_COORD_CODES.index(modal.coord_system) + 1)
+    base = _coord_base(modal)
     if interp.params.get(5210 + base):
         return False                        # G10 L2 R: rotated
     numbered = interp.params._numbered
